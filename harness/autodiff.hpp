@@ -1,0 +1,55 @@
+// Forward-mode automatic differentiation on Eigen's AutoDiffScalar with
+// fixed-size derivative vectors (no heap allocation).
+#pragma once
+
+#include <Eigen/Dense>
+#include <unsupported/Eigen/AutoDiff>
+#include <type_traits>
+
+namespace cstab::ad {
+
+// A scalar carrying K directional derivatives.
+template <int K, class Base = double>
+using Dual = Eigen::AutoDiffScalar<Eigen::Matrix<Base, K, 1>>;
+
+// One more level of a single directional derivative on top of T.
+template <class T>
+using Nest = Eigen::AutoDiffScalar<Eigen::Matrix<T, 1, 1>>;
+
+template <class Base, int L>
+struct NestN {
+  using type = Nest<typename NestN<Base, L - 1>::type>;
+};
+template <class Base>
+struct NestN<Base, 0> {
+  using type = Base;
+};
+
+// Value of a (possibly nested) scalar at the level of Base.
+template <class Base, class T>
+Base collapse(const T& x) {
+  if constexpr (std::is_same_v<T, Base>) {
+    return x;
+  } else {
+    return collapse<Base>(x.value());
+  }
+}
+
+// For x = g(Z_L) with Z_{k+1} = Z_k + eps_{k+1} F(Z_k): out[k] = L_F^k g at Z_0.
+template <class Base, class T>
+void extract_levels(const T& x, Base* out) {
+  out[0] = collapse<Base>(x);
+  if constexpr (!std::is_same_v<T, Base>) extract_levels<Base>(x.derivatives()(0), out + 1);
+}
+
+// Gradient of a scalar function f(Eigen::Matrix<Dual<N>,N,1>) at x.
+template <int N, class F>
+double gradient(const F& f, const Eigen::Matrix<double, N, 1>& x, Eigen::Matrix<double, N, 1>& grad) {
+  Eigen::Matrix<Dual<N>, N, 1> xd;
+  for (int i = 0; i < N; ++i) xd(i) = Dual<N>(x(i), N, i);
+  const Dual<N> r = f(xd);
+  grad = r.derivatives();
+  return r.value();
+}
+
+}  // namespace cstab::ad

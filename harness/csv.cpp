@@ -1,0 +1,66 @@
+#include "csv.hpp"
+
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
+#include <stdexcept>
+
+namespace cstab {
+
+AtomicFile::AtomicFile(std::string path) : path_(std::move(path)) {
+  temp_path_ = path_ + ".tmp." + std::to_string(::getpid());
+  file_ = std::fopen(temp_path_.c_str(), "w");
+  if (!file_)
+    throw std::runtime_error("cannot write " + path_ + ": " + std::strerror(errno));
+}
+
+AtomicFile::~AtomicFile() {
+  if (file_) std::fclose(file_);
+  if (!committed_) std::remove(temp_path_.c_str());
+}
+
+void AtomicFile::write(const std::string& text) {
+  std::fwrite(text.data(), 1, text.size(), file_);
+}
+
+void AtomicFile::commit() {
+  const bool write_error = std::ferror(file_) != 0;
+  const bool close_error = std::fclose(file_) != 0;
+  file_ = nullptr;
+  if (write_error || close_error)
+    throw std::runtime_error("error writing " + path_);
+  if (std::rename(temp_path_.c_str(), path_.c_str()) != 0)
+    throw std::runtime_error("cannot rename into " + path_ + ": " + std::strerror(errno));
+  committed_ = true;
+}
+
+std::string csv_field(const std::string& s) {
+  if (s.find_first_of(",\"\n\r") == std::string::npos) return s;
+  std::string out = "\"";
+  for (char c : s) {
+    if (c == '"') out += '"';
+    out += c;
+  }
+  return out + "\"";
+}
+
+void write_key_value_csv(const std::string& path,
+                         const std::vector<std::pair<std::string, std::string>>& row) {
+  std::string header, values;
+  for (const auto& [k, v] : row) {
+    header += (header.empty() ? "" : ",") + csv_field(k);
+    values += (values.empty() && &k == &row.front().first ? "" : ",") + csv_field(v);
+  }
+  AtomicFile f(path);
+  f.write(header + "\n" + values + "\n");
+  f.commit();
+}
+
+void write_file_atomic(const std::string& path, const std::string& content) {
+  AtomicFile f(path);
+  f.write(content);
+  f.commit();
+}
+
+}  // namespace cstab

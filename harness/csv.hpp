@@ -1,0 +1,41 @@
+// Atomic CSV output: rows go to a temporary file beside the target, which is
+// renamed into place only by commit(). A writer destroyed without commit()
+// removes its temporary file, so no half-written CSV is ever left behind.
+#pragma once
+
+#include <cstdio>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace cstab {
+
+class AtomicFile {
+ public:
+  explicit AtomicFile(std::string path);
+  ~AtomicFile();
+  AtomicFile(const AtomicFile&) = delete;
+  AtomicFile& operator=(const AtomicFile&) = delete;
+
+  std::FILE* stream() { return file_; }
+  void write(const std::string& text);
+  void commit();  // flush, fsync-free close, rename; throws on I/O error
+  const std::string& path() const { return path_; }
+
+ private:
+  std::string path_, temp_path_;
+  std::FILE* file_ = nullptr;
+  bool committed_ = false;
+};
+
+// Quote a CSV field if it needs it (RFC 4180).
+std::string csv_field(const std::string& s);
+
+// One header line and one data row from ordered (column, value) pairs.
+void write_key_value_csv(const std::string& path,
+                         const std::vector<std::pair<std::string, std::string>>& row);
+
+// Write `content` to `path` atomically.
+void write_file_atomic(const std::string& path, const std::string& content);
+
+}  // namespace cstab

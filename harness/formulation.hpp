@@ -1,0 +1,53 @@
+// What a method hands to the harness: a first-order system an integrator can
+// step, plus the observables the harness records (residuals per constraint,
+// the problem's canonical coordinates). Integrators see only OdeSystem.
+#pragma once
+
+#include <cmath>
+#include <string>
+#include <vector>
+
+namespace cstab {
+
+// y' = f(t, y) on raw arrays of `dimension()` doubles. Implementations keep
+// all workspaces as members, so rhs() never allocates.
+class OdeSystem {
+ public:
+  virtual ~OdeSystem() = default;
+  virtual int dimension() const = 0;
+  // Returns false if the right-hand side cannot be evaluated (singular
+  // reaction matrix, non-finite input); failure_reason() then says why.
+  virtual bool rhs(double t, const double* y, double* dydt) = 0;
+  virtual const std::string& failure_reason() const { return no_failure_; }
+
+ private:
+  std::string no_failure_;
+};
+
+struct ConstraintInfo {
+  std::string name;  // used in column names: residual_<name>
+  std::string kind;  // holonomic | non-holonomic | holonomic (time-dependent) | ...
+  std::string description;
+};
+
+class Formulation : public OdeSystem {
+ public:
+  // Short name of the form the problem is written in ("state-space",
+  // "mechanical", "minimal"), reported in the summary's `formulation` column.
+  virtual std::string formulation_name() const = 0;
+  virtual void initial_state(double* y) const = 0;
+  // Post-step hook (projection methods). Returns true if it changed y.
+  virtual bool has_post_step() const { return false; }
+  virtual bool post_step(double /*t*/, double* /*y*/) { return false; }
+
+  // Observables.
+  virtual const std::vector<ConstraintInfo>& constraints() const = 0;
+  virtual void residuals(double t, const double* y, double* out) const = 0;
+  // Maps the state to the problem's canonical coordinates (series columns).
+  virtual void to_canonical(double t, const double* y, double* canonical) const = 0;
+  // Condition number of the matrix the method solves for the reactions, if any.
+  virtual bool has_condition_number() const { return false; }
+  virtual double condition_number(double /*t*/, const double* /*y*/) { return std::nan(""); }
+};
+
+}  // namespace cstab

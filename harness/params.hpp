@@ -1,0 +1,56 @@
+// Method parameters: a declared list of named real values with defaults and
+// bounds, parsed once from "--param name=value" before a run starts.
+#pragma once
+
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace cstab {
+
+// Thrown for any bad input a user can fix (unknown names, bad numbers, ...).
+// The CLI turns it into a one-line message and exit code 2.
+struct UsageError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+enum class Bound { kAny, kPositive, kNonNegative };
+
+struct ParamSpec {
+  std::string name;
+  double default_value;
+  Bound bound;
+  std::string description;
+};
+
+// Resolved parameter values: every declared name has a value.
+class Params {
+ public:
+  Params() = default;
+
+  // Checks `given` (name, value text) against `specs`; throws UsageError naming
+  // the offending parameter.
+  static Params resolve(const std::vector<ParamSpec>& specs,
+                        const std::vector<std::pair<std::string, std::string>>& given,
+                        const std::string& method_name);
+
+  double get(const std::string& name) const;
+  bool has(const std::string& name) const;
+  // Whether the user set this parameter explicitly (not the default).
+  bool given(const std::string& name) const;
+  // "a=1;b=2" in declaration order, for the summary's `params` column.
+  std::string describe() const;
+  const std::vector<std::pair<std::string, double>>& values() const { return values_; }
+
+ private:
+  std::vector<std::pair<std::string, double>> values_;
+  std::vector<std::string> given_;
+};
+
+// Strict number parsing: the whole text must be a finite number.
+double parse_finite_double(const std::string& text, const std::string& what);
+
+}  // namespace cstab

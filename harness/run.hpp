@@ -1,0 +1,75 @@
+// One run: problem x method x integrator over [0, t_end], observed step by
+// step. Records per-constraint residuals, energy and first-integral drift,
+// error against the problem's reference, counts and wall time, and writes
+// summary.csv and series.csv atomically.
+#pragma once
+
+#include <cmath>
+#include <limits>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "integrator.hpp"
+#include "problem.hpp"
+
+namespace cstab {
+
+struct RunConfig {
+  std::string problem;
+  std::string method;
+  std::string formulation;  // empty: the method's default for this problem
+  std::string integrator;
+  std::vector<std::pair<std::string, std::string>> params;  // name, value text
+  StepSettings step;
+  double t_end = std::numeric_limits<double>::quiet_NaN();
+  std::vector<double> times;       // exact output times in (0, t_end]
+  double sample_every = 0;         // series decimation; 0: t_end / 1000
+  double ref_time = -1;            // < 0: the problem's default (if <= t_end); 0: none
+  double blowup = 1e3;             // residual above this: diverged
+  int observe_every = 1;           // metrics every N steps (always at outputs)
+  bool write_series = true;
+};
+
+struct ConstraintMetrics {
+  std::string name;
+  double max_abs = 0;
+  double final_abs = 0;
+};
+
+struct RunResult {
+  std::string problem, formulation, method, params, integrator;
+  std::string status = "ok";  // ok | diverged | failed
+  std::string reason;
+  double fail_time = std::numeric_limits<double>::quiet_NaN();
+  double t_end = 0, t_reached = 0;
+  StepSettings step;
+  long steps = 0, rejected_steps = 0, rhs_evals = 0;
+  double wall_seconds = 0;     // integration alone (observation excluded)
+  double observe_seconds = 0;  // time spent in observers
+  std::vector<ConstraintMetrics> constraints;
+  double max_residual = 0, final_residual = 0;
+  bool has_energy = false;
+  double max_energy_drift = std::numeric_limits<double>::quiet_NaN();
+  double final_energy_drift = std::numeric_limits<double>::quiet_NaN();
+  std::vector<std::pair<std::string, double>> max_integral_drift;
+  double max_condition = std::numeric_limits<double>::quiet_NaN();
+  double ref_time = std::numeric_limits<double>::quiet_NaN();
+  double ref_error = std::numeric_limits<double>::quiet_NaN();  // max abs over coordinates
+  double ref_scd = std::numeric_limits<double>::quiet_NaN();    // significant correct digits
+  std::vector<double> ref_state, state_at_ref;                  // canonical
+  std::vector<double> final_state;                              // canonical, at t_reached
+  std::vector<std::pair<std::string, std::string>> extra;       // method-specific counters
+
+  std::vector<std::pair<std::string, std::string>> summary_row() const;
+};
+
+// Validates everything (throws UsageError) before touching the filesystem.
+// With out_dir empty nothing is written.
+RunResult run_case(const Problem& problem, const RunConfig& config, const std::string& out_dir);
+
+// Significant correct digits of `y` against `ref` (IVP Test Set mescd with
+// atol/rtol = 1): min over components of -log10(|y-ref| / (1 + |ref|)).
+double significant_digits(const std::vector<double>& y, const std::vector<double>& ref);
+
+}  // namespace cstab

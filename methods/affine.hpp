@@ -1,0 +1,99 @@
+// The affine (state-space) form of Pesterev et al., eqs. (1)-(4):
+//     X' = F(t, X) + B(t, X) N,   outputs f_i(t, X) = 0, i = 1..m,
+// with N the m unknown reactions and r_i the relative degree of output i.
+//
+// A model type provides (sizes fixed at compile time):
+//   static constexpr int kStates, kInputs;
+//   static constexpr std::array<int, kInputs> kRelativeDegree;
+//   template <class S> void drift(const S& t, const Vec<S, kStates>& X, Vec<S, kStates>& F) const;
+//   void input_matrix(double t, const Vec<double, kStates>& X, Mat<kStates, kInputs>& B) const;
+//   template <class S> void outputs(const S& t, const Vec<S, kStates>& X, Vec<S, kInputs>& f) const;
+// and the observables listed in AffineModelObservables below.
+//
+// LieJet computes, by nested forward-mode AD, everything lambda-feedback
+// needs: L_F^k f_i for k < r_i, the rows A_i = L_B L_F^{r_i-1} f_i and
+// L_F^{r_i} f_i (eq. 4). Time enters as a state moving with unit speed
+// along F, so time-dependent outputs need nothing extra.
+#pragma once
+
+#include <algorithm>
+#include <array>
+
+#include "harness/autodiff.hpp"
+
+namespace cstab {
+
+template <class S, int N>
+using Vec = Eigen::Matrix<S, N, 1>;
+
+// Fixed-size views of raw state arrays.
+template <int N>
+Eigen::Map<Vec<double, N>> vmap(double* p) {
+  return Eigen::Map<Vec<double, N>>(p);
+}
+template <int N>
+Eigen::Map<const Vec<double, N>> vmap(const double* p) {
+  return Eigen::Map<const Vec<double, N>>(p);
+}
+
+template <class Model>
+class LieJet {
+ public:
+  static constexpr int n = Model::kStates;
+  static constexpr int m = Model::kInputs;
+  static constexpr int kMaxDegree =
+      *std::max_element(Model::kRelativeDegree.begin(), Model::kRelativeDegree.end());
+  using Outer = ad::Dual<m + 1>;  // directions: B columns, then F
+
+  // A(i, :) = L_B L_F^{r_i - 1} f_i; top(i) = L_F^{r_i} f_i;
+  // lower(i, k) = L_F^k f_i for k < r_i.
+  Eigen::Matrix<double, m, m> A;
+  Vec<double, m> top;
+  Eigen::Matrix<double, m, kMaxDegree> lower;
+  Vec<double, n> F;
+  Eigen::Matrix<double, n, m> B;
+
+  void evaluate(const Model& model, double t, const Vec<double, n>& X) {
+    model.drift(t, X, F);
+    model.input_matrix(t, X, B);
+    Vec<Outer, n> Y;
+    for (int i = 0; i < n; ++i) {
+      Eigen::Matrix<double, m + 1, 1> d;
+      d.template head<m>() = B.row(i).transpose();
+      d(m) = F(i);
+      Y(i) = Outer(X(i), d);
+    }
+    Eigen::Matrix<double, m + 1, 1> dt = Eigen::Matrix<double, m + 1, 1>::Zero();
+    dt(m) = 1.0;
+    const Outer tY(t, dt);
+    lift<kMaxDegree - 1>(model, tY, Y);
+  }
+
+ private:
+  template <int L, class T>
+  void lift(const Model& model, const T& t, const Vec<T, n>& Z) {
+    if constexpr (L == 0) {
+      Vec<T, m> f;
+      model.outputs(t, Z, f);
+      std::array<Outer, kMaxDegree> levels;
+      for (int i = 0; i < m; ++i) {
+        ad::extract_levels<Outer>(f(i), levels.data());
+        const int r = Model::kRelativeDegree[i];
+        for (int k = 0; k < kMaxDegree; ++k) lower(i, k) = k < r ? levels[k].value() : 0.0;
+        const Outer& last = levels[r - 1];
+        A.row(i) = last.derivatives().template head<m>().transpose();
+        top(i) = last.derivatives()(m);
+      }
+    } else {
+      using N = ad::Nest<T>;
+      Vec<T, n> FZ;
+      model.drift(t, Z, FZ);
+      Vec<N, n> Zn;
+      for (int i = 0; i < n; ++i) Zn(i) = N(Z(i), Eigen::Matrix<T, 1, 1>(FZ(i)));
+      const N tn(t, Eigen::Matrix<T, 1, 1>(T(1.0)));
+      lift<L - 1>(model, tn, Zn);
+    }
+  }
+};
+
+}  // namespace cstab

@@ -1,0 +1,160 @@
+// Pesterev-Matrosov-Morozov lambda-feedback (control-based) stabilization.
+// Each output f_i of relative degree r_i is made to obey
+//     (d/dt + lambda_i)^{r_i} f_i = 0                      (eq. 7, repeated roots)
+// which, with eq. (4), gives the linear system for the reactions
+//     A(X) N + phi(X, lambda) = 0,   phi_i = L_F^{r_i} f_i + sum_{k<r_i} C(r_i,k) lambda_i^{r_i-k} L_F^k f_i
+// (eqs. 8-10). N is substituted into X' = F + B N and any integrator steps it.
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "harness/formulation.hpp"
+#include "harness/params.hpp"
+#include "methods/affine.hpp"
+
+namespace cstab {
+
+namespace pesterev_detail {
+inline double binomial(int n, int k) {
+  double r = 1;
+  for (int i = 1; i <= k; ++i) r = r * (n - k + i) / i;
+  return r;
+}
+}  // namespace pesterev_detail
+
+template <class Model>
+class PesterevFormulation final : public Formulation {
+ public:
+  static constexpr int n = Model::kStates;
+  static constexpr int m = Model::kInputs;
+
+  PesterevFormulation(const Model& model, const Params& params)
+      : model_(model), constraints_(model.constraints()) {
+    const double lambda = params.get("lambda");
+    for (int i = 0; i < m; ++i) {
+      const std::string key = "lambda_" + constraints_[i].name;
+      const double li = params.given(key) ? params.get(key) : lambda;
+      const int r = Model::kRelativeDegree[i];
+      // gains_(i, k) multiplies L_F^k f_i.
+      for (int k = 0; k < LieJet<Model>::kMaxDegree; ++k)
+        gains_(i, k) = k < r ? pesterev_detail::binomial(r, k) * std::pow(li, r - k) : 0.0;
+    }
+    // Relative degrees are declared by the model; check them where the run
+    // starts: A(X0) must be nonsingular.
+    Vec<double, n> X0;
+    model_.initial_state(X0);
+    jet_.evaluate(model_, 0.0, X0);
+    lu_.compute(jet_.A);
+    if (!(lu_.rcond() > 1e-12))
+      throw UsageError("pesterev: declared relative degrees do not hold at the initial state "
+                       "(A(X0) singular, rcond " + std::to_string(lu_.rcond()) + ")");
+  }
+
+  std::string formulation_name() const override { return model_.formulation_name(); }
+  int dimension() const override { return n; }
+  void initial_state(double* y) const override {
+    Vec<double, n> X;
+    model_.initial_state(X);
+    vmap<n>(y) = X;
+  }
+
+  bool rhs(double t, const double* y, double* dydt) override {
+    const Eigen::Map<const Vec<double, n>> X(y);
+    jet_.evaluate(model_, t, X);
+    Vec<double, m> phi = jet_.top;
+    for (int i = 0; i < m; ++i) phi(i) += jet_.lower.row(i).dot(gains_.row(i));
+    lu_.compute(jet_.A);
+    const double rcond = lu_.rcond();
+    if (!(rcond > 1e-14)) {
+      failure_ = "reaction matrix A(X) singular (rcond " + std::to_string(rcond) + ") at t = " +
+                 std::to_string(t);
+      return false;
+    }
+    const Vec<double, m> N = lu_.solve(-phi);
+    vmap<n>(dydt) = jet_.F + jet_.B * N;
+    return true;
+  }
+  const std::string& failure_reason() const override { return failure_; }
+
+  const std::vector<ConstraintInfo>& constraints() const override { return constraints_; }
+  void residuals(double t, const double* y, double* out) const override {
+    Vec<double, m> f;
+    model_.outputs(t, Eigen::Map<const Vec<double, n>>(y).eval(), f);
+    vmap<m>(out) = f;
+  }
+  void to_canonical(double t, const double* y, double* c) const override {
+    model_.to_canonical(t, Eigen::Map<const Vec<double, n>>(y).eval(), c);
+  }
+  bool has_condition_number() const override { return true; }
+  double condition_number(double t, const double* y) override {
+    jet_.evaluate(model_, t, Eigen::Map<const Vec<double, n>>(y));
+    Eigen::JacobiSVD<Eigen::Matrix<double, m, m>> svd(jet_.A);
+    const auto& s = svd.singularValues();
+    return s(m - 1) > 0 ? s(0) / s(m - 1) : std::numeric_limits<double>::infinity();
+  }
+
+ private:
+  Model model_;
+  std::vector<ConstraintInfo> constraints_;
+  Eigen::Matrix<double, m, LieJet<Model>::kMaxDegree> gains_;
+  LieJet<Model> jet_;
+  Eigen::PartialPivLU<Eigen::Matrix<double, m, m>> lu_;
+  std::string failure_;
+};
+
+// Registry entry: applies to any problem with an affine (state-space) model.
+struct PesterevMethod {
+  static constexpr const char* kName = "pesterev";
+  static constexpr const char* kDescription =
+      "lambda-feedback: (d/dt + lambda)^r f = 0 per output, reactions from A(X) N + phi = 0 "
+      "(Pesterev-Matrosov-Morozov)";
+  static std::vector<ParamSpec> generic_params() {
+    return {{"lambda", 1500, Bound::kPositive, "repeated root -lambda of every output's characteristic equation"}};
+  }
+
+  template <class P>
+  static std::string why_not(const P&) {
+    if constexpr (requires(const P& p) { p.state_space(); }) {
+      return {};
+    } else {
+      return "problem has no affine (state-space) model";
+    }
+  }
+
+  template <class P>
+  static std::vector<ParamSpec> params(const P& p, const std::string& formulation) {
+    check_formulation(p, formulation);
+    auto specs = generic_params();
+    if constexpr (requires { p.state_space(); }) {
+      for (const auto& c : p.state_space().constraints())
+        specs.push_back({"lambda_" + c.name, specs[0].default_value, Bound::kPositive,
+                         "lambda for output '" + c.name + "' (default: lambda)"});
+    }
+    return specs;
+  }
+
+  template <class P>
+  static std::unique_ptr<Formulation> make(const P& p, const std::string& formulation, const Params& params) {
+    check_formulation(p, formulation);
+    if constexpr (requires { p.state_space(); }) {
+      using Model = std::decay_t<decltype(p.state_space())>;
+      return std::make_unique<PesterevFormulation<Model>>(p.state_space(), params);
+    } else {
+      throw UsageError("pesterev: problem has no affine model");
+    }
+  }
+
+ private:
+  template <class P>
+  static void check_formulation(const P& p, const std::string& formulation) {
+    if constexpr (requires { p.state_space(); }) {
+      if (!formulation.empty() && formulation != p.state_space().formulation_name())
+        throw UsageError("--formulation " + formulation + ": pesterev runs on '" +
+                         p.state_space().formulation_name() + "'");
+    }
+  }
+};
+
+}  // namespace cstab
