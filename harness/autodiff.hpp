@@ -53,3 +53,48 @@ double gradient(const F& f, const Eigen::Matrix<double, N, 1>& x, Eigen::Matrix<
 }
 
 }  // namespace cstab::ad
+
+namespace cstab::ad {
+
+// The plain double inside any (nested) AD scalar.
+template <class T>
+double scalar_value(const T& x) {
+  if constexpr (std::is_arithmetic_v<T>) {
+    return x;
+  } else {
+    return scalar_value(x.value());
+  }
+}
+
+// x solving an SPD system M x = b by an unpivoted Cholesky, for any scalar
+// type (AD types included); fixed size, no allocation.
+template <class S, int N>
+Eigen::Matrix<S, N, 1> spd_solve(const Eigen::Matrix<S, N, N>& M, const Eigen::Matrix<S, N, 1>& b) {
+  using std::sqrt;
+  Eigen::Matrix<S, N, N> L = Eigen::Matrix<S, N, N>::Zero();
+  for (int j = 0; j < N; ++j) {
+    S d = M(j, j);
+    for (int k = 0; k < j; ++k) d -= L(j, k) * L(j, k);
+    L(j, j) = sqrt(d);
+    for (int i = j + 1; i < N; ++i) {
+      S s = M(i, j);
+      for (int k = 0; k < j; ++k) s -= L(i, k) * L(j, k);
+      L(i, j) = s / L(j, j);
+    }
+  }
+  Eigen::Matrix<S, N, 1> y;
+  for (int i = 0; i < N; ++i) {
+    S s = b(i);
+    for (int k = 0; k < i; ++k) s -= L(i, k) * y(k);
+    y(i) = s / L(i, i);
+  }
+  Eigen::Matrix<S, N, 1> x;
+  for (int i = N - 1; i >= 0; --i) {
+    S s = y(i);
+    for (int k = i + 1; k < N; ++k) s -= L(k, i) * x(k);
+    x(i) = s / L(i, i);
+  }
+  return x;
+}
+
+}  // namespace cstab::ad

@@ -36,6 +36,10 @@ class Formulation : public OdeSystem {
   // "mechanical", "minimal"), reported in the summary's `formulation` column.
   virtual std::string formulation_name() const = 0;
   virtual void initial_state(double* y) const = 0;
+  // Told the integrator's fixed step before the run (0 for adaptive
+  // schemes); a formulation whose parameters depend on it may throw
+  // UsageError here for an impossible combination.
+  virtual void set_step_hint(double /*fixed_step*/) {}
   // Post-step hook (projection methods). Returns true if it changed y.
   virtual bool has_post_step() const { return false; }
   virtual bool post_step(double /*t*/, double* /*y*/) { return false; }

@@ -14,6 +14,7 @@ namespace cstab {
 
 const std::vector<IntegratorInfo>& all_integrators() {
   static const std::vector<IntegratorInfo> list = {
+      {"euler", "explicit (forward) Euler, fixed step", true, 1},
       {"rk4", "classical 4th-order Runge-Kutta, fixed step", true, 4},
       {"adams", "Adams-Bashforth-Moulton PECE, 4th order, fixed step (RK4 start-up)", true, 4},
       {"rk8pd", "GSL Prince-Dormand 8(9), adaptive", false, 8},
@@ -111,6 +112,19 @@ class Rk4 final : public FixedStep {
   bool advance(double t_next) override {
     (void)t_next;
     return rk4(t_, y_.data(), h_, y_.data(), false);
+  }
+};
+
+class Euler final : public FixedStep {
+ public:
+  using FixedStep::FixedStep;
+  bool notify_modified() override { return true; }
+
+ private:
+  bool advance(double) override {
+    if (!eval(t_, y_.data(), k1_.data())) return false;
+    for (int i = 0; i < n_; ++i) y_[i] += h_ * k1_[i];
+    return true;
   }
 };
 
@@ -270,6 +284,7 @@ std::unique_ptr<Integrator> make_integrator(const std::string& name, const StepS
     if (!(s.atol > 0) || !std::isfinite(s.atol))
       throw UsageError("--atol: integrator '" + name + "' needs a finite atol > 0");
   }
+  if (name == "euler") return std::make_unique<Euler>(s.step);
   if (name == "rk4") return std::make_unique<Rk4>(s.step);
   if (name == "adams") return std::make_unique<AdamsPece>(s.step);
   if (name == "rk8pd") return std::make_unique<GslAdaptive>(gsl_odeiv2_step_rk8pd, s, false);

@@ -184,6 +184,7 @@ RunResult run_case(const Problem& problem, const RunConfig& cfg, const std::stri
   const Params params = Params::resolve(specs, cfg.params, cfg.method);
   auto form = problem.make(cfg.method, cfg.formulation, params);
   auto integrator = make_integrator(cfg.integrator, cfg.step);
+  form->set_step_hint(integ_info.fixed_step ? cfg.step.step : 0.0);
 
   RunResult result;
   result.problem = cfg.problem;

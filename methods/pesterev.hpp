@@ -13,6 +13,7 @@
 #include "harness/formulation.hpp"
 #include "harness/params.hpp"
 #include "methods/affine.hpp"
+#include "methods/mechanical_affine.hpp"
 
 namespace cstab {
 
@@ -104,56 +105,64 @@ class PesterevFormulation final : public Formulation {
   std::string failure_;
 };
 
-// Registry entry: applies to any problem with an affine (state-space) model.
+// Registry entry: applies to any problem with an affine (state-space) model,
+// and to any mechanical model through MechanicalAsAffine.
 struct PesterevMethod {
   static constexpr const char* kName = "pesterev";
   static constexpr const char* kDescription =
       "lambda-feedback: (d/dt + lambda)^r f = 0 per output, reactions from A(X) N + phi = 0 "
-      "(Pesterev-Matrosov-Morozov)";
+      "(Pesterev-Matrosov-Morozov); runs on the state-space form or on a mechanical model as an affine system";
   static std::vector<ParamSpec> generic_params() {
     return {{"lambda", 1500, Bound::kPositive, "repeated root -lambda of every output's characteristic equation"}};
   }
 
   template <class P>
   static std::string why_not(const P&) {
-    if constexpr (requires(const P& p) { p.state_space(); }) {
+    if constexpr (requires(const P& p) { p.state_space(); } || HasMechanical<P>) {
       return {};
     } else {
-      return "problem has no affine (state-space) model";
+      return "problem has neither an affine (state-space) nor a mechanical model";
     }
   }
 
   template <class P>
   static std::vector<ParamSpec> params(const P& p, const std::string& formulation) {
-    check_formulation(p, formulation);
     auto specs = generic_params();
-    if constexpr (requires { p.state_space(); }) {
-      for (const auto& c : p.state_space().constraints())
-        specs.push_back({"lambda_" + c.name, specs[0].default_value, Bound::kPositive,
-                         "lambda for output '" + c.name + "' (default: lambda)"});
-    }
+    for (const auto& c : constraints_of(p, formulation))
+      specs.push_back({"lambda_" + c.name, specs[0].default_value, Bound::kPositive,
+                       "lambda for output '" + c.name + "' (default: lambda)"});
     return specs;
   }
 
   template <class P>
   static std::unique_ptr<Formulation> make(const P& p, const std::string& formulation, const Params& params) {
-    check_formulation(p, formulation);
     if constexpr (requires { p.state_space(); }) {
-      using Model = std::decay_t<decltype(p.state_space())>;
-      return std::make_unique<PesterevFormulation<Model>>(p.state_space(), params);
-    } else {
-      throw UsageError("pesterev: problem has no affine model");
+      if (formulation.empty() || formulation == p.state_space().formulation_name()) {
+        using Model = std::decay_t<decltype(p.state_space())>;
+        return std::make_unique<PesterevFormulation<Model>>(p.state_space(), params);
+      }
     }
+    if constexpr (HasMechanical<P>) {
+      if (formulation.empty() || formulation == p.mechanical().formulation_name()) {
+        using Model = MechanicalAsAffine<std::decay_t<decltype(p.mechanical())>>;
+        return std::make_unique<PesterevFormulation<Model>>(Model(p.mechanical()), params);
+      }
+    }
+    throw UsageError("--formulation " + formulation + ": pesterev cannot run on it");
   }
 
  private:
   template <class P>
-  static void check_formulation(const P& p, const std::string& formulation) {
+  static std::vector<ConstraintInfo> constraints_of(const P& p, const std::string& formulation) {
     if constexpr (requires { p.state_space(); }) {
-      if (!formulation.empty() && formulation != p.state_space().formulation_name())
-        throw UsageError("--formulation " + formulation + ": pesterev runs on '" +
-                         p.state_space().formulation_name() + "'");
+      if (formulation.empty() || formulation == p.state_space().formulation_name())
+        return p.state_space().constraints();
     }
+    if constexpr (HasMechanical<P>) {
+      if (formulation.empty() || formulation == p.mechanical().formulation_name())
+        return p.mechanical().constraints();
+    }
+    throw UsageError("--formulation " + formulation + ": pesterev cannot run on it");
   }
 };
 

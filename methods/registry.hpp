@@ -2,6 +2,9 @@
 // in MethodList.
 #pragma once
 
+#include "methods/baumgarte.hpp"
+#include "methods/braun_goldfarb.hpp"
+#include "methods/index1.hpp"
 #include "methods/minimal.hpp"
 #include "methods/pesterev.hpp"
 
@@ -10,6 +13,7 @@ namespace cstab {
 template <class... Ms>
 struct TypeList {};
 
-using MethodList = TypeList<PesterevMethod, MinimalMethod>;
+using MethodList = TypeList<PesterevMethod, BaumgarteMethod, BraunGoldfarbMethod, ProjectionMethod, NoneMethod,
+                            MinimalMethod>;
 
 }  // namespace cstab

@@ -150,6 +150,29 @@ double WheelMinimal::energy(const Vec<double, kStates>& y) const {
   return 0.5 * qd.dot(M * qd) + V;
 }
 
+void WheelMechanical::initial_state(Vec<double, 4>& q, Vec<double, 4>& v) const {
+  Vec<double, WheelStateSpace::kStates> X;
+  ss_.initial_state(X);
+  using W = WheelStateSpace;
+  q << X(W::iX), X(W::iZ), X(W::iTH), X(W::iPHI);
+  v << X(W::iXD), X(W::iZD), X(W::iTHD), X(W::iPHID);
+}
+
+void WheelMechanical::to_canonical(double, const Vec<double, 4>& q, const Vec<double, 4>& v, double* c) const {
+  using W = WheelStateSpace;
+  const double s = contact(q(qX), q(qZ));
+  const double d1 = p_.dp(s), w = std::sqrt(1 + d1 * d1);
+  c[W::iX] = q(qX);
+  c[W::iXD] = v(qX);
+  c[W::iZ] = q(qZ);
+  c[W::iZD] = v(qZ);
+  c[W::iTH] = q(qTH);
+  c[W::iTHD] = v(qTH);
+  c[W::iPHI] = q(qPHI);
+  c[W::iPHID] = v(qPHI);
+  c[W::iALPHA] = std::atan2(-1 / w, d1 / w);
+}
+
 // ---------------------------------------------------------------------------
 
 ProblemInfo Wheel::info() const {
@@ -164,6 +187,8 @@ ProblemInfo Wheel::info() const {
        WheelStateSpace::constraints()},
       {"minimal", "Lagrange equations in (s, phi), theta from rolling; no constraints to drift",
        WheelStateSpace::constraints()},
+      {"mechanical", "q = (x, z, theta, phi) with M, Q; distance-to-curve + rolling constraints",
+       WheelMechanical(params_).constraints()},
   };
   info.has_energy = true;
   info.default_t_end = 200;

@@ -24,6 +24,7 @@
 #include <vector>
 
 #include "harness/formulation.hpp"
+#include "harness/autodiff.hpp"
 #include "harness/problem.hpp"
 #include "methods/affine.hpp"
 
@@ -147,14 +148,115 @@ class WheelMinimal {
   WheelStateSpace ss_;
 };
 
+// The wheel as a mechanical system: q = (x, z, theta, phi), the mass matrix
+// and forces of the Lagrangian (13)-(14); one holonomic constraint
+// "signed distance from the centre to the curve = r" (the contact point
+// s(q) found by a closest-point Newton solve) and rolling without slip.
+class WheelMechanical {
+ public:
+  static constexpr int kCoords = 4, kHolonomic = 1, kNonholonomic = 1;
+  static constexpr bool kHasEnergy = true;
+  enum { qX, qZ, qTH, qPHI };
+
+  explicit WheelMechanical(const WheelParameters& p) : p_(p), ss_(p) {}
+
+  std::string formulation_name() const { return "mechanical"; }
+  std::vector<ConstraintInfo> constraints() const {
+    return {{"distance", "holonomic", "signed distance from the centre to the curve minus r"},
+            {"rolling", "non-holonomic", "(xdot + p'(s) zdot)/w + r thetadot: no slip at the contact s(q)"}};
+  }
+  void initial_state(Vec<double, 4>& q, Vec<double, 4>& v) const;
+  void to_canonical(double t, const Vec<double, 4>& q, const Vec<double, 4>& v, double* c) const;
+
+  template <class S>
+  void mass(const S&, const Vec<S, 4>& q, Eigen::Matrix<S, 4, 4>& M) const {
+    using std::cos;
+    using std::sin;
+    const double Mm = p_.M + p_.m, ml = p_.m * p_.l;
+    M.setZero();
+    M(qX, qX) = S(Mm);
+    M(qZ, qZ) = S(Mm);
+    M(qTH, qTH) = S(p_.M * p_.r * p_.r);
+    M(qPHI, qPHI) = S(ml * p_.l);
+    M(qX, qPHI) = M(qPHI, qX) = ml * cos(q(qPHI));
+    M(qZ, qPHI) = M(qPHI, qZ) = ml * sin(q(qPHI));
+  }
+  template <class S>
+  void forces(const S&, const Vec<S, 4>& q, const Vec<S, 4>& v, Vec<S, 4>& Q) const {
+    using std::cos;
+    using std::sin;
+    const double ml = p_.m * p_.l;
+    const S w2 = v(qPHI) * v(qPHI);
+    Q(qX) = ml * w2 * sin(q(qPHI));
+    Q(qZ) = -ml * w2 * cos(q(qPHI)) - (p_.M + p_.m) * p_.g;
+    Q(qTH) = S(0.0);
+    Q(qPHI) = -p_.m * p_.g * p_.l * sin(q(qPHI));
+  }
+  template <class S>
+  void holonomic(const S&, const Vec<S, 4>& q, Vec<S, 1>& phi) const {
+    using std::sqrt;
+    const S s = contact(q(qX), q(qZ));
+    const S d1 = p_.dp(s);
+    phi(0) = ((q(qX) - s) * (-d1) + (q(qZ) - p_.p(s))) / sqrt(1.0 + d1 * d1) - p_.r;
+  }
+  template <class S>
+  void nonholonomic(const S&, const Vec<S, 4>& q, const Vec<S, 4>& v, Vec<S, 1>& psi) const {
+    using std::sqrt;
+    const S d1 = p_.dp(contact(q(qX), q(qZ)));
+    psi(0) = (v(qX) + d1 * v(qZ)) / sqrt(1.0 + d1 * d1) + p_.r * v(qTH);
+  }
+  template <class S>
+  S energy(const S&, const Vec<S, 4>& q, const Vec<S, 4>& v) const {
+    Eigen::Matrix<S, 4, 4> M;
+    mass(S(0.0), q, M);
+    using std::cos;
+    return 0.5 * v.dot(M * v) + (p_.M + p_.m) * p_.g * q(qZ) - p_.m * p_.g * p_.l * cos(q(qPHI));
+  }
+
+  // Foot of the normal from (x, z) to the curve: (s - x) + (p(s) - z) p'(s) = 0.
+  // Newton in double to convergence, then two Newton steps in S so that AD
+  // derivatives (up to second order) of s(x, z) are exact.
+  template <class S>
+  S contact(const S& x, const S& z) const {
+    const double xv = ad::scalar_value(x), zv = ad::scalar_value(z);
+    // Start from the foot of the normal at x: the contact is about r (p', -1)/w
+    // away from the centre. (Starting at s = x fails on steep, curved parts
+    // where the Newton derivative changes sign between x and the contact.)
+    const double slope = p_.dp(xv);
+    double s = xv + p_.r * slope / std::sqrt(1 + slope * slope);
+    for (int it = 0; it < 50; ++it) {
+      const double g = (s - xv) + (p_.p(s) - zv) * p_.dp(s);
+      double dg = 1 + p_.dp(s) * p_.dp(s) + (p_.p(s) - zv) * p_.ddp(s);
+      // Far from the foot the distance may be locally concave: fall back to
+      // a gradient step scaled by the Gauss-Newton term.
+      if (dg < 0.1) dg = 1 + p_.dp(s) * p_.dp(s);
+      const double ds = g / dg;
+      s -= ds;
+      if (std::abs(ds) < 1e-15) break;
+    }
+    S sa(s);
+    for (int k = 0; k < 2; ++k) {
+      const S g = (sa - x) + (p_.p(sa) - z) * p_.dp(sa);
+      const S dg = 1.0 + p_.dp(sa) * p_.dp(sa) + (p_.p(sa) - z) * p_.ddp(sa);
+      sa = sa - g / dg;
+    }
+    return sa;
+  }
+
+ private:
+  WheelParameters p_;
+  WheelStateSpace ss_;
+};
+
 class Wheel {
  public:
-  Wheel() : ss_(params_), minimal_(params_) {}
-  explicit Wheel(const WheelParameters& p) : params_(p), ss_(p), minimal_(p) {}
+  Wheel() : ss_(params_), minimal_(params_), mechanical_(params_) {}
+  explicit Wheel(const WheelParameters& p) : params_(p), ss_(p), minimal_(p), mechanical_(p) {}
 
   ProblemInfo info() const;
   const WheelStateSpace& state_space() const { return ss_; }
   const WheelMinimal& minimal() const { return minimal_; }
+  const WheelMechanical& mechanical() const { return mechanical_; }
   double energy(double t, const double* canonical) const;
   // Minimal-coordinate solution by GSL rk8pd at rtol = atol = 1e-13, cached.
   bool reference(double t, double* canonical) const;
@@ -163,6 +265,7 @@ class Wheel {
   WheelParameters params_;
   WheelStateSpace ss_;
   WheelMinimal minimal_;
+  WheelMechanical mechanical_;
   struct Cache {
     std::mutex mutex;
     std::map<double, std::vector<double>> states;

@@ -1,0 +1,115 @@
+// The index-1 (acceleration-level) formulation
+//     q' = v,  v' = a,  a = a_free + R^-1 C^+ (-gamma - A a_free - stab),  a_free = M^-1 Q
+// i.e. Gauss's principle with the constraint rows differentiated to the
+// acceleration level (A a + gamma = -stab). With a rank-revealing
+// pseudo-inverse this also holds for redundant rows.
+//   none       : stab = 0, nothing else - the drift is visible.
+//   projection : stab = 0, after every step positions are projected onto
+//                Phi = 0 (mass-weighted Gauss-Newton), then velocities onto
+//                the velocity constraints (one linear solve).
+#pragma once
+
+#include <cmath>
+
+#include "methods/mechanical_method.hpp"
+#include "methods/weighted_pinv.hpp"
+
+namespace cstab {
+
+template <class Model>
+class IndexOneFormulation : public MechanicalFormulationBase<Model> {
+  using Base = MechanicalFormulationBase<Model>;
+
+ public:
+  using Base::nc;
+  using Base::nh;
+  using Base::nn;
+  using Base::nq;
+  using typename Base::VecQ;
+
+  IndexOneFormulation(const Model& model, bool project, double tol, int max_iter)
+      : Base(model), project_(project), tol_(tol), max_iter_(max_iter) {}
+
+  bool rhs(double t, const double* y, double* dydt) override {
+    const VecQ q = vmap<nq>(y), v = vmap<nq>(y + nq);
+    terms_.evaluate(this->model_, t, q, v, false);
+    if (!pinv_.factor_mass(terms_.M)) {
+      this->failure_ = "mass matrix not positive definite at t = " + std::to_string(t);
+      return false;
+    }
+    VecQ a = pinv_.mass_solve(terms_.Q);
+    if constexpr (nc > 0) {
+      pinv_.set_rows(terms_.A);
+      a += pinv_.correction(-terms_.gamma - terms_.A * a);
+    }
+    vmap<nq>(dydt) = v;
+    vmap<nq>(dydt + nq) = a;
+    return true;
+  }
+
+  bool has_post_step() const override { return project_; }
+
+  bool post_step(double t, double* y) override {
+    if constexpr (nc == 0) {
+      return false;
+    } else {
+      auto q = vmap<nq>(y);
+      auto v = vmap<nq>(y + nq);
+      this->model_.mass(t, VecQ(q), M_);
+      if (!pos_pinv_.factor_mass(M_)) return false;
+      if constexpr (nh > 0) {
+        for (int it = 0; it < max_iter_; ++it) {
+          pos_terms_.evaluate_position(this->model_, t, q);
+          if (pos_terms_.phi.template lpNorm<Eigen::Infinity>() <= tol_) break;
+          pos_pinv_.set_rows(pos_terms_.A.template topRows<nh>());
+          q -= pos_pinv_.correction(pos_terms_.phi);
+        }
+      }
+      // Velocity constraints are affine in v: one correction is exact.
+      this->model_.mass(t, VecQ(q), M_);
+      if (!vel_pinv_.factor_mass(M_)) return false;
+      vel_terms_.evaluate_velocity(this->model_, t, q, v);
+      vel_pinv_.set_rows(vel_terms_.A);
+      v -= vel_pinv_.correction(vel_terms_.velocity);
+      return true;
+    }
+  }
+
+ private:
+  bool project_;
+  double tol_;
+  int max_iter_;
+  MechanicalTerms<Model> terms_, pos_terms_, vel_terms_;
+  Eigen::Matrix<double, nq, nq> M_;
+  WeightedPinv<nc, nq> pinv_, vel_pinv_;
+  WeightedPinv<(nh > 0 ? nh : 1), nq> pos_pinv_;
+};
+
+struct NoneMethod : MechanicalMethod<NoneMethod> {
+  static constexpr const char* kName = "none";
+  static constexpr const char* kDescription =
+      "index-1 ODE (constraints at acceleration level) with no stabilization: drift is visible";
+  static std::vector<ParamSpec> generic_params() { return {}; }
+  template <class Model>
+  static std::unique_ptr<Formulation> make_model(const Model& model, const Params&) {
+    return std::make_unique<IndexOneFormulation<Model>>(model, false, 0.0, 0);
+  }
+};
+
+struct ProjectionMethod : MechanicalMethod<ProjectionMethod> {
+  static constexpr const char* kName = "projection";
+  static constexpr const char* kDescription =
+      "index-1 ODE + post-step projection of positions (mass-weighted Gauss-Newton) then velocities";
+  static std::vector<ParamSpec> generic_params() {
+    return {{"tol", 1e-13, Bound::kPositive, "stop the position iteration when max |Phi| <= tol"},
+            {"max_iter", 5, Bound::kPositive, "Gauss-Newton iterations per step at most"}};
+  }
+  template <class Model>
+  static std::unique_ptr<Formulation> make_model(const Model& model, const Params& params) {
+    const double max_iter = params.get("max_iter");
+    if (max_iter != std::floor(max_iter)) throw UsageError("--param max_iter: must be an integer");
+    return std::make_unique<IndexOneFormulation<Model>>(model, true, params.get("tol"), int(max_iter));
+  }
+};
+
+}  // namespace cstab

@@ -1,0 +1,211 @@
+// The mechanical-system description every mechanical method uses:
+//     M(t, q) a = Q(t, q, v) + A^T lambda,   q' = v,  v' = a,
+//     holonomic      Phi(t, q) = 0                      (kHolonomic rows)
+//     non-holonomic  Psi(t, q, v) = G(t, q) v + g(t, q) = 0 (kNonholonomic rows)
+//     energy law     E(t, q, v) = E(0)                  (if kHasEnergy)
+//
+// A model type provides (sizes fixed at compile time):
+//   static constexpr int kCoords, kHolonomic, kNonholonomic;
+//   static constexpr bool kHasEnergy;
+//   std::string formulation_name() const;
+//   std::vector<ConstraintInfo> constraints() const;   // holonomic rows first
+//   template <class S> void mass(const S& t, const Vec<S,nq>& q, Eigen::Matrix<S,nq,nq>& M) const;
+//   template <class S> void forces(const S& t, const Vec<S,nq>& q, const Vec<S,nq>& v, Vec<S,nq>& Q) const;
+//   template <class S> void holonomic(const S& t, const Vec<S,nq>& q, Vec<S,nh>& phi) const;        (nh > 0)
+//   template <class S> void nonholonomic(const S& t, const Vec<S,nq>& q, const Vec<S,nq>& v, Vec<S,nn>& psi) const; (nn > 0)
+//   template <class S> S energy(const S& t, const Vec<S,nq>& q, const Vec<S,nq>& v) const;         (kHasEnergy)
+//   void initial_state(Vec<double,nq>& q, Vec<double,nq>& v) const;
+//   void to_canonical(double t, const Vec<double,nq>& q, const Vec<double,nq>& v, double* c) const;
+// Only what a model declares is evaluated: no holonomic terms for nh = 0, no
+// non-holonomic terms for nn = 0, no energy terms without an energy law.
+//
+// Every derivative (Jacobians, the acceleration-level terms, the energy
+// gradient) comes from forward-mode AD here; models write only the functions.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "harness/autodiff.hpp"
+#include "harness/formulation.hpp"
+#include "methods/affine.hpp"
+
+namespace cstab {
+
+template <class Model>
+struct MechanicalTerms {
+  static constexpr int nq = Model::kCoords;
+  static constexpr int nh = Model::kHolonomic;
+  static constexpr int nn = Model::kNonholonomic;
+  static constexpr int nc = nh + nn;
+  using VecQ = Vec<double, nq>;
+  using MatQ = Eigen::Matrix<double, nq, nq>;
+
+  MatQ M;
+  VecQ Q;
+  // Rows: holonomic Jacobian J = dPhi/dq, then G = dPsi/dv. The constraint
+  // rows at acceleration level read A a + gamma.
+  Eigen::Matrix<double, nc, nq> A;
+  Vec<double, nc> gamma;
+  Vec<double, nh> phi;       // position-level residual
+  Vec<double, nc> velocity;  // [J v + Phi_t; Psi]: velocity-level residual
+  Vec<double, nh> phi_t;     // dPhi/dt
+  // Energy law: E, dE/dv, and dE/dt with a = 0 (the part not through a).
+  double energy = 0;
+  VecQ energy_grad_v = VecQ::Zero();
+  double energy_rate_free = 0;
+
+  // Positions only (projection needs no forces): phi, J (rows 0..nh), phi_t.
+  void evaluate_position(const Model& model, double t, const VecQ& q) {
+    if constexpr (nh > 0) {
+      using D = ad::Dual<nq + 1>;
+      Vec<D, nq> qd;
+      for (int i = 0; i < nq; ++i) qd(i) = D(q(i), nq + 1, i);
+      const D td(t, nq + 1, nq);
+      Vec<D, nh> f;
+      model.holonomic(td, qd, f);
+      for (int i = 0; i < nh; ++i) {
+        phi(i) = f(i).value();
+        A.row(i) = f(i).derivatives().template head<nq>().transpose();
+        phi_t(i) = f(i).derivatives()(nq);
+      }
+    }
+  }
+
+  // Velocity rows only: A and the velocity residual (affine in v).
+  void evaluate_velocity(const Model& model, double t, const VecQ& q, const VecQ& v) {
+    evaluate_position(model, t, q);
+    if constexpr (nh > 0) velocity.template head<nh>() = A.template topRows<nh>() * v + phi_t;
+    if constexpr (nn > 0) nonholonomic_terms(model, t, q, v);
+  }
+
+  void evaluate(const Model& model, double t, const VecQ& q, const VecQ& v, bool with_energy) {
+    model.mass(t, q, M);
+    model.forces(t, q, v, Q);
+    if constexpr (nh > 0) {
+      evaluate_position(model, t, q);
+      // Second derivative of Phi(t + s, q + s v) at s = 0 (hyper-dual):
+      // gamma = d/dt (J v + Phi_t) with v frozen; the first derivative is J v + Phi_t.
+      using D1 = ad::Dual<1>;
+      using H = ad::Nest<D1>;
+      Vec<H, nq> qh;
+      for (int i = 0; i < nq; ++i)
+        qh(i) = H(D1(q(i), Eigen::Matrix<double, 1, 1>(v(i))), Eigen::Matrix<D1, 1, 1>(D1(v(i), Eigen::Matrix<double, 1, 1>(0.0))));
+      const H th(D1(t, Eigen::Matrix<double, 1, 1>(1.0)), Eigen::Matrix<D1, 1, 1>(D1(1.0, Eigen::Matrix<double, 1, 1>(0.0))));
+      Vec<H, nh> f;
+      model.holonomic(th, qh, f);
+      for (int i = 0; i < nh; ++i) {
+        velocity(i) = f(i).value().derivatives()(0);
+        gamma(i) = f(i).derivatives()(0).derivatives()(0);
+      }
+    }
+    if constexpr (nn > 0) nonholonomic_terms(model, t, q, v);
+    if constexpr (Model::kHasEnergy) {
+      if (with_energy) {
+        // Directions: the nq velocities, then the line (t + s, q + s v).
+        using D = ad::Dual<nq + 1>;
+        Vec<D, nq> qd, vd;
+        for (int i = 0; i < nq; ++i) {
+          Eigen::Matrix<double, nq + 1, 1> dq = Eigen::Matrix<double, nq + 1, 1>::Zero();
+          dq(nq) = v(i);
+          qd(i) = D(q(i), dq);
+          vd(i) = D(v(i), nq + 1, i);
+        }
+        const D td(t, nq + 1, nq);
+        const D e = model.energy(td, qd, vd);
+        energy = e.value();
+        energy_grad_v = e.derivatives().template head<nq>();
+        energy_rate_free = e.derivatives()(nq);
+      }
+    }
+  }
+
+ private:
+  void nonholonomic_terms(const Model& model, double t, const VecQ& q, const VecQ& v) {
+    using D = ad::Dual<nq + 1>;
+    Vec<D, nq> qd, vd;
+    for (int i = 0; i < nq; ++i) {
+      Eigen::Matrix<double, nq + 1, 1> dq = Eigen::Matrix<double, nq + 1, 1>::Zero();
+      dq(nq) = v(i);
+      qd(i) = D(q(i), dq);
+      vd(i) = D(v(i), nq + 1, i);
+    }
+    const D td(t, nq + 1, nq);
+    Vec<D, nn> psi;
+    model.nonholonomic(td, qd, vd, psi);
+    for (int i = 0; i < nn; ++i) {
+      velocity(nh + i) = psi(i).value();
+      A.row(nh + i) = psi(i).derivatives().template head<nq>().transpose();
+      gamma(nh + i) = psi(i).derivatives()(nq);
+    }
+  }
+};
+
+// Shared parts of every formulation on y = [q; v].
+template <class Model>
+class MechanicalFormulationBase : public Formulation {
+ public:
+  static constexpr int nq = Model::kCoords;
+  static constexpr int nh = Model::kHolonomic;
+  static constexpr int nn = Model::kNonholonomic;
+  static constexpr int nc = nh + nn;
+  using VecQ = Vec<double, nq>;
+
+  explicit MechanicalFormulationBase(const Model& model) : model_(model), constraints_(model.constraints()) {}
+
+  std::string formulation_name() const override { return model_.formulation_name(); }
+  int dimension() const override { return 2 * nq; }
+  void initial_state(double* y) const override {
+    VecQ q, v;
+    model_.initial_state(q, v);
+    vmap<nq>(y) = q;
+    vmap<nq>(y + nq) = v;
+  }
+  const std::vector<ConstraintInfo>& constraints() const override { return constraints_; }
+  void residuals(double t, const double* y, double* out) const override {
+    const VecQ q = vmap<nq>(y), v = vmap<nq>(y + nq);
+    if constexpr (nh > 0) {
+      Vec<double, nh> phi;
+      model_.holonomic(t, q, phi);
+      for (int i = 0; i < nh; ++i) out[i] = phi(i);
+    }
+    if constexpr (nn > 0) {
+      Vec<double, nn> psi;
+      model_.nonholonomic(t, q, v, psi);
+      for (int i = 0; i < nn; ++i) out[nh + i] = psi(i);
+    }
+  }
+  void to_canonical(double t, const double* y, double* c) const override {
+    model_.to_canonical(t, vmap<nq>(y).eval(), vmap<nq>(y + nq).eval(), c);
+  }
+  const std::string& failure_reason() const override { return failure_; }
+
+ protected:
+  Model model_;
+  std::vector<ConstraintInfo> constraints_;
+  std::string failure_;
+};
+
+// Rank of the constraint rows at the initial state (for methods that need
+// full rank to say so before running).
+template <class Model>
+int initial_constraint_rank(const Model& model, int* rows) {
+  constexpr int nq = Model::kCoords;
+  MechanicalTerms<Model> terms;
+  Vec<double, nq> q, v;
+  model.initial_state(q, v);
+  terms.evaluate(model, 0.0, q, v, false);
+  *rows = MechanicalTerms<Model>::nc;
+  if constexpr (MechanicalTerms<Model>::nc == 0) {
+    return 0;
+  } else {
+    Eigen::CompleteOrthogonalDecomposition<Eigen::Matrix<double, MechanicalTerms<Model>::nc, nq>> cod(terms.A);
+    return int(cod.rank());
+  }
+}
+
+// Shared applicability check for methods that run on P::mechanical().
+template <class P>
+concept HasMechanical = requires(const P& p) { p.mechanical(); };
+
+}  // namespace cstab

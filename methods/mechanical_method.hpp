@@ -1,0 +1,74 @@
+// Registry plumbing shared by the methods that run on a problem's
+// mechanical model (P::mechanical()).
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "harness/params.hpp"
+#include "methods/mechanical.hpp"
+
+namespace cstab {
+
+template <class Derived>
+struct MechanicalMethod {
+  template <class P>
+  static std::string why_not(const P& p) {
+    if constexpr (HasMechanical<P>) {
+      return Derived::template why_not_model(p.mechanical());
+    } else {
+      return "problem has no mechanical (M, Q, constraints) model";
+    }
+  }
+
+  template <class P>
+  static std::vector<ParamSpec> params(const P& p, const std::string& formulation) {
+    check_formulation(p, formulation);
+    if constexpr (HasMechanical<P>) {
+      return Derived::template model_params(p.mechanical());
+    } else {
+      return {};
+    }
+  }
+
+  template <class P>
+  static std::unique_ptr<Formulation> make(const P& p, const std::string& formulation, const Params& params) {
+    check_formulation(p, formulation);
+    if constexpr (HasMechanical<P>) {
+      return Derived::template make_model(p.mechanical(), params);
+    } else {
+      throw UsageError(std::string(Derived::kName) + ": problem has no mechanical model");
+    }
+  }
+
+  // Default: applies to every mechanical model.
+  template <class Model>
+  static std::string why_not_model(const Model&) { return {}; }
+  template <class Model>
+  static std::vector<ParamSpec> model_params(const Model&) { return Derived::generic_params(); }
+
+ private:
+  template <class P>
+  static void check_formulation(const P& p, const std::string& formulation) {
+    if constexpr (HasMechanical<P>) {
+      if (!formulation.empty() && formulation != p.mechanical().formulation_name())
+        throw UsageError("--formulation " + formulation + ": " + Derived::kName + " runs on '" +
+                         p.mechanical().formulation_name() + "'");
+    }
+  }
+};
+
+// For methods that need full-rank constraint rows: an error naming the
+// redundancy, thrown before the run starts.
+template <class Model>
+void require_full_rank(const Model& model, const std::string& method) {
+  int rows = 0;
+  const int rank = initial_constraint_rank(model, &rows);
+  if (rank < rows)
+    throw UsageError(method + ": the constraint rows are redundant at the initial state (rank " +
+                     std::to_string(rank) + " of " + std::to_string(rows) + "); " + method +
+                     " needs full rank (braun-goldfarb and projection handle redundancy)");
+}
+
+}  // namespace cstab
