@@ -1,0 +1,100 @@
+// cstab stability --problem P --method M --integrator I --gain-param NAME
+//                 --steps h1,h2,... --gains g1,g2,... --t-end T --out DIR
+//                 [--param k=v ...] [--formulation F] [--blowup B] [--bisect N]
+// Writes DIR/stability.csv (the h x gain map), DIR/boundary.csv (per step:
+// the measured boundary in h*rate and the integrator's theoretical real
+// stability interval) and, if gnuplot is present, DIR/stability.png/.svg.
+#include "cli/stability_command.hpp"
+
+#include <cstdlib>
+#include <filesystem>
+#include <iostream>
+
+#include "cli/args.hpp"
+#include "harness/csv.hpp"
+#include "harness/format.hpp"
+#include "harness/integrator.hpp"
+#include "harness/stability.hpp"
+#include "problems/registry.hpp"
+
+namespace cstab::cli {
+
+int cmd_stability(const std::vector<std::string>& argv) {
+  Args args(argv,
+            {"--problem", "--method", "--formulation", "--integrator", "--gain-param", "--steps", "--gains",
+             "--t-end", "--out", "--param", "--blowup", "--bisect"},
+            {"--no-plot"}, {"--param"});
+  if (!args.positional().empty()) throw UsageError("stability: unexpected argument '" + args.positional()[0] + "'");
+  StabilityConfig cfg;
+  cfg.base.problem = args.require("--problem");
+  cfg.base.method = args.require("--method");
+  cfg.base.formulation = args.get("--formulation");
+  cfg.base.integrator = args.require("--integrator");
+  const Problem& problem = find_problem(cfg.base.problem);
+  if (!find_integrator(cfg.base.integrator).fixed_step)
+    throw UsageError("--integrator " + cfg.base.integrator + ": stability maps need a fixed-step integrator");
+  cfg.gain_param = args.require("--gain-param");
+  for (const auto& kv : args.all("--param")) {
+    const auto eq = kv.find('=');
+    if (eq == std::string::npos || eq == 0) throw UsageError("--param " + kv + ": expected name=value");
+    if (kv.substr(0, eq) == cfg.gain_param) throw UsageError("--param " + kv + ": that is the swept --gain-param");
+    cfg.base.params.emplace_back(kv.substr(0, eq), kv.substr(eq + 1));
+  }
+  cfg.steps = args.number_list("--steps");
+  cfg.gains = args.number_list("--gains");
+  if (cfg.steps.empty()) throw UsageError("--steps: required (comma-separated)");
+  for (double h : cfg.steps)
+    if (!(h > 0)) throw UsageError("--steps: " + format_short(h) + " must be > 0");
+  for (double g : cfg.gains)
+    if (!(g > 0)) throw UsageError("--gains: " + format_short(g) + " must be > 0");
+  cfg.base.t_end = parse_finite_double(args.require("--t-end"), "--t-end");
+  if (!(cfg.base.t_end > 0)) throw UsageError("--t-end: must be > 0");
+  cfg.base.blowup = args.number("--blowup", 1.0);
+  if (!(cfg.base.blowup > 0)) throw UsageError("--blowup: must be > 0");
+  cfg.bisection_iterations = int(args.integer("--bisect", 10));
+  if (cfg.bisection_iterations < 0) throw UsageError("--bisect: must be >= 0");
+  const std::string out = args.require("--out");
+
+  // Validate the combination (method, gain parameter) with one cheap run
+  // before creating any file.
+  {
+    RunConfig probe = cfg.base;
+    probe.step.step = cfg.steps.front();
+    probe.t_end = cfg.steps.front();
+    probe.ref_time = 0;
+    probe.write_series = false;
+    probe.params.emplace_back(cfg.gain_param, "1");
+    run_case(problem, probe, "");
+  }
+
+  const auto map = stability_map(problem, cfg);
+  const auto bounds = stability_boundaries(problem, cfg);
+
+  std::error_code ec;
+  std::filesystem::create_directories(out, ec);
+  if (ec) throw UsageError("--out " + out + ": cannot create folder: " + ec.message());
+  std::string grid = "problem,method,integrator,gain_param,step,gain,rate,h_rate,status,max_residual,final_residual,fail_time\n";
+  for (const auto& p : map)
+    grid += cfg.base.problem + "," + cfg.base.method + "," + cfg.base.integrator + "," + cfg.gain_param + "," +
+            format_exact(p.step) + "," + format_exact(p.gain) + "," + format_exact(p.rate) + "," +
+            format_exact(p.step * p.rate) + "," + p.status + "," + format_exact(p.max_residual) + "," +
+            format_exact(p.final_residual) + "," + (std::isnan(p.fail_time) ? "" : format_exact(p.fail_time)) + "\n";
+  write_file_atomic(out + "/stability.csv", grid);
+  std::string bcsv = "problem,method,integrator,gain_param,step,stable_rate,unstable_rate,measured_h_rate,theory_h_rate,ratio\n";
+  std::cout << "step        measured h*rate   theory   ratio\n";
+  for (const auto& b : bounds) {
+    bcsv += cfg.base.problem + "," + cfg.base.method + "," + cfg.base.integrator + "," + cfg.gain_param + "," +
+            format_exact(b.step) + "," + format_exact(b.stable_rate) + "," + format_exact(b.unstable_rate) + "," +
+            format_exact(b.measured) + "," + format_exact(b.theory) + "," + format_exact(b.measured / b.theory) + "\n";
+    std::printf("%-10.3g  %-16.4g  %-7.4g  %.3f\n", b.step, b.measured, b.theory, b.measured / b.theory);
+  }
+  write_file_atomic(out + "/boundary.csv", bcsv);
+  if (!args.has("--no-plot") && std::system("command -v gnuplot >/dev/null 2>&1") == 0) {
+    const std::string cmd = "gnuplot -e \"dir='" + out + "'\" " CSTAB_SOURCE_DIR "/plots/stability.gp";
+    if (std::system(cmd.c_str()) != 0) std::cerr << "cstab stability: warning: gnuplot failed\n";
+  }
+  std::cout << "wrote " << out << "/stability.csv and boundary.csv\n";
+  return 0;
+}
+
+}  // namespace cstab::cli

@@ -1,0 +1,52 @@
+// Linear stability of the fixed-step integrators and measured stability
+// boundaries of stabilized runs (issue: replace "lambda about 1/h" folklore
+// with maps).
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "harness/problem.hpp"
+#include "harness/run.hpp"
+
+namespace cstab {
+
+// The left end -x of the real stability interval [-x, 0] of a fixed-step
+// integrator applied to y' = mu y, computed from its stability polynomial:
+// one-step methods from |R(z)| <= 1, the Adams PECE pair from the roots of
+// its characteristic polynomial. 0 if the integrator is not fixed-step.
+double real_stability_boundary(const std::string& integrator);
+
+struct StabilityPoint {
+  double step = 0;
+  double gain = 0;       // the parameter value given
+  double rate = 0;       // the decay rate it implies (gain, or 1/gain for dt)
+  std::string status;    // ok | diverged | failed
+  double max_residual = 0;
+  double final_residual = 0;
+  double fail_time = 0;  // NaN if it did not blow up
+};
+
+struct StabilityConfig {
+  RunConfig base;              // problem, method, integrator, t_end, other params
+  std::string gain_param;      // lambda, alpha (sets alpha = beta), dt, ...
+  std::vector<double> steps;
+  std::vector<double> gains;   // grid values
+  int bisection_iterations = 10;  // boundary search per step size
+};
+
+struct StabilityBoundary {
+  double step = 0;
+  double stable_rate = 0;    // largest rate found stable
+  double unstable_rate = 0;  // smallest rate found unstable
+  double measured = 0;       // h * rate at the boundary (geometric mid)
+  double theory = 0;         // real_stability_boundary(integrator)
+};
+
+// The decay rate a gain value implies for the method's residual dynamics.
+double rate_of_gain(const std::string& gain_param, double gain);
+
+std::vector<StabilityPoint> stability_map(const Problem& problem, const StabilityConfig& config);
+std::vector<StabilityBoundary> stability_boundaries(const Problem& problem, const StabilityConfig& config);
+
+}  // namespace cstab
