@@ -4,6 +4,7 @@
 #include <sstream>
 
 #include "cli/args.hpp"
+#include "cli/matrix_commands.hpp"
 #include "harness/format.hpp"
 #include "harness/integrator.hpp"
 #include "harness/run.hpp"
@@ -21,6 +22,11 @@ usage:
             --integrator I (--step H | --rtol R --atol A) --t-end T
             [--times t1,t2,...] [--sample-every DT] [--ref-time T]
             [--blowup B] [--observe-every N] --out DIR
+  cstab matrix [FILE] --out DIR [--jobs N] [--shard k/N] [--filter S] [--force]
+               [--no-report] [--list] [--print-default]
+               runs a benchmark matrix (default: the embedded one; docs/matrix.md)
+  cstab merge OUT SHARD_DIR... [--jobs N] [--no-report]
+  cstab report DIR [--jobs N] [--no-plots]
 
 Exit codes: 0 success (a diverged run is a recorded result), 2 bad input, 1 internal error.
 See README.md for every column of summary.csv and series.csv.
@@ -133,7 +139,10 @@ int cmd_run(const std::vector<std::string>& argv) {
 int dispatch(const std::string& command, const std::vector<std::string>& args) {
   if (command == "list") return cmd_list(args);
   if (command == "run") return cmd_run(args);
-  throw UsageError("unknown command '" + command + "' (known: list, run)");
+  if (command == "matrix") return cmd_matrix(args);
+  if (command == "merge") return cmd_merge(args);
+  if (command == "report") return cmd_report(args);
+  throw UsageError("unknown command '" + command + "' (known: list, run, matrix, merge, report)");
 }
 
 }  // namespace cstab::cli

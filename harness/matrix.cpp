@@ -588,6 +588,10 @@ Expansion expand_matrix(const MatrixFile& file, const MatrixCatalog& catalog) {
       for (const auto* v : integrator_names) {
         auto it = std::find_if(all_integrators().begin(), all_integrators().end(),
                                [&](const IntegratorInfo& i) { return i.name == v->text; });
+        if (it == all_integrators().end() && optional) {
+          note("integrator '" + v->text + "' is not in this build (optional sweep): skipped");
+          continue;
+        }
         if (it == all_integrators().end()) {
           std::vector<std::string> known;
           for (const auto& i : all_integrators()) known.push_back(i.name);
@@ -620,9 +624,9 @@ Expansion expand_matrix(const MatrixFile& file, const MatrixCatalog& catalog) {
       if (!i->fixed_step && !have_tol)
         throw MatrixError(at, "integrator '" + i->name + "' is adaptive: the sweep needs 'tol' (or 'rtol' and 'atol')");
     }
-    if (!steps.empty() && !any_fixed)
+    if (!steps.empty() && !any_fixed && !integrators.empty())
       throw MatrixError(set.find("step")->where, "'step' given but no integrator of the sweep is fixed-step");
-    if (have_tol && !any_adaptive)
+    if (have_tol && !any_adaptive && !integrators.empty())
       throw MatrixError((tols.empty() ? set.find("rtol") : set.find("tol"))->where,
                         "tolerances given but no integrator of the sweep is adaptive");
 

@@ -145,12 +145,13 @@ struct MatrixRunOptions {
   bool force = false;          // rerun even if cached
   std::string binary_id;       // part of every cache key
   std::string matrix_text;     // stored as DIR/matrix.toml
-  size_t matrix_cases = 0;     // size of the full expansion (for the manifest)
+  size_t selected_cases = 0;   // cases after --filter, before --shard (merge checks coverage)
   std::function<const Problem&(const std::string&)> find_problem;
 };
 
 struct MatrixRunStats {
   size_t total = 0, run = 0, cached = 0, failed = 0, diverged = 0;
+  size_t not_applicable = 0;  // rejected by the harness before running (status "invalid")
   double seconds = 0;
 };
 
@@ -164,8 +165,9 @@ MatrixRunStats run_matrix(const std::vector<MatrixCase>& cases, const MatrixRunO
                           std::ostream& log, bool log_is_tty);
 
 // The manifest DIR/cases.csv.
-void write_manifest(const std::string& path, const std::vector<CaseEntry>& entries, size_t matrix_cases);
-std::vector<CaseEntry> read_manifest(const std::string& path, size_t* matrix_cases = nullptr);
+// `selected_cases`: how many cases the run was given before sharding.
+void write_manifest(const std::string& path, const std::vector<CaseEntry>& entries, size_t selected_cases);
+std::vector<CaseEntry> read_manifest(const std::string& path, size_t* selected_cases = nullptr);
 
 // DIR/summary.csv: every case's summary rows (one per repeat) in expansion
 // order, columns case_id, repeat, sweep, then the union of all cases'
@@ -175,7 +177,8 @@ size_t write_matrix_summary(const std::string& dir, const std::vector<CaseEntry>
 
 // Joins shard folders into out_dir: checks they ran the same matrix, copies
 // the case folders, writes the union manifest, provenance of every shard
-// and summary.csv. Returns the number of cases missing from all shards.
+// and summary.csv. Returns the number of cases missing (not in any shard, or
+// without a complete result).
 size_t merge_results(const std::string& out_dir, const std::vector<std::string>& shard_dirs,
                      std::ostream& log);
 

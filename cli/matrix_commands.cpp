@@ -1,0 +1,256 @@
+#include "cli/matrix_commands.hpp"
+
+#include <unistd.h>
+
+#include <filesystem>
+#include <map>
+#include <iostream>
+#include <thread>
+
+#include "cli/args.hpp"
+#include "harness/csv.hpp"
+#include "harness/matrix.hpp"
+#include "harness/provenance.hpp"
+#include "harness/report.hpp"
+#include "methods/dispatch.hpp"
+#include "problems/registry.hpp"
+
+namespace cstab::cli {
+
+namespace {
+
+// The default matrix. "all" expands at run time, so problems and methods
+// added to the registries join it without an edit here. Budget: <= 10 min
+// with --jobs 2 on a 2-core machine (README, docs/matrix.md).
+const char* kDefaultMatrix = R"(# cstab default matrix (embedded; `cstab matrix --print-default` prints it).
+# Every problem x every applicable method: a work-precision sweep per
+# integrator family up to the problem's reference time, one long run per
+# method for the time-series overlays, and the papers' own settings.
+
+[defaults]
+problems = "all"
+methods = "all"
+t_end = "ref"        # the problem's reference time: error against the reference is defined there
+repeats = 3          # wall time = median of the repeats
+
+# Fixed step, classical RK4 (Braun-Goldfarb's integrator), coarse to fine.
+[[sweep]]
+name = "wp-rk4"
+integrators = ["rk4"]
+step = [1e-2, 5e-3, 2e-3, 1e-3, 5e-4, 2e-4, 1e-4]
+
+# Fixed step, Adams-Bashforth-Moulton PECE (Pesterev et al.'s integrator).
+[[sweep]]
+name = "wp-adams"
+integrators = ["adams"]
+step = [2e-3, 1e-3, 5e-4, 2e-4, 1e-4, 5e-5, 2e-5]
+
+# Adaptive Prince-Dormand 8(9), rtol = atol = tol. Braun-Goldfarb's
+# correction time scale is the step of a fixed-step integrator; here 1 ms.
+[[sweep]]
+name = "wp-rk8pd"
+integrators = ["rk8pd"]
+tol = [1e-6, 1e-7, 1e-8, 1e-9, 1e-10, 1e-11, 1e-12]
+param.braun-goldfarb.dt = 1e-3
+
+# DAE formulations on SUNDIALS IDA (variable-order BDF).
+[[sweep]]
+name = "wp-ida"
+methods = ["ida-index1", "ida-ggl"]
+integrators = ["ida"]
+tol = [1e-6, 1e-7, 1e-8, 1e-9, 1e-10]
+optional = true
+
+# The problem's own horizon, one integrator for every method: residual and
+# drift against time (overlays).
+[[sweep]]
+name = "long"
+integrators = ["rk8pd"]
+tol = 1e-10
+t_end = "default"
+param.braun-goldfarb.dt = 1e-3
+repeats = 1
+work_precision = false
+overlay = true
+
+[[sweep]]
+name = "long-ida"
+methods = ["ida-index1", "ida-ggl"]
+integrators = ["ida"]
+tol = 1e-10
+t_end = "default"
+repeats = 1
+work_precision = false
+overlay = true
+optional = true
+
+# Pesterev, Matrosov, Morozov: Adams, fixed step 1e-5, lambda = 1500, t in [0, 200].
+[[sweep]]
+name = "paper-pesterev"
+problems = ["wheel"]
+methods = ["pesterev"]
+integrators = ["adams"]
+step = 1e-5
+t_end = 200
+param.lambda = 1500
+repeats = 1
+work_precision = false
+optional = true
+
+# Braun, Goldfarb: RK4, dt = 1e-2, t in [0, 100].
+[[sweep]]
+name = "paper-braun-goldfarb"
+problems = ["ball", "biped"]
+methods = ["braun-goldfarb"]
+integrators = ["rk4"]
+step = 1e-2
+t_end = 100
+repeats = 1
+work_precision = false
+optional = true
+)";
+
+MatrixCatalog registry_catalog() {
+  MatrixCatalog catalog;
+  for (const auto& p : all_problems()) catalog.problems.push_back(p.get());
+  catalog.methods = all_methods();
+  return catalog;
+}
+
+int default_jobs() { return std::max(1u, std::thread::hardware_concurrency()); }
+
+int jobs_flag(const Args& args) {
+  const long jobs = args.integer("--jobs", default_jobs());
+  if (jobs < 1 || jobs > 1024) throw UsageError("--jobs: must be in [1, 1024]");
+  return int(jobs);
+}
+
+void finish(const std::string& dir, int jobs, bool plots) {
+  ReportOptions ro;
+  ro.jobs = jobs;
+  ro.plots = plots;
+  const ReportResult r = build_report(dir, ro, std::cerr);
+  std::cout << "report: " << r.html << " (" << r.plots_drawn << " plots drawn, " << r.plots_reused
+            << " unchanged)\n";
+}
+
+}  // namespace
+
+const std::string& default_matrix_text() {
+  static const std::string text = kDefaultMatrix;
+  return text;
+}
+
+int cmd_matrix(const std::vector<std::string>& argv) {
+  Args args(argv, {"--out", "--jobs", "--shard", "--filter"}, {"--force", "--list", "--no-report", "--print-default"});
+  if (args.has("--print-default")) {
+    std::cout << default_matrix_text();
+    return 0;
+  }
+  if (args.positional().size() > 1)
+    throw UsageError("matrix: one matrix file at most (got '" + args.positional()[1] + "' too)");
+  const bool from_file = !args.positional().empty();
+  const MatrixFile file = from_file ? read_matrix_file(args.positional()[0])
+                                    : parse_matrix(default_matrix_text(), "<default matrix>");
+  const Expansion expansion = expand_matrix(file, registry_catalog());
+  int shard_k = 1, shard_n = 1;
+  if (args.has("--shard")) std::tie(shard_k, shard_n) = parse_shard(args.require("--shard"));
+  const std::string filter = args.get("--filter");
+  const auto filtered = select_cases(expansion.cases, filter, 1, 1);
+  const auto cases = select_cases(filtered, "", shard_k, shard_n);
+
+  if (args.has("--list")) {
+    for (const auto& n : expansion.notes) std::cout << "# note: " << n << "\n";
+    for (const auto& c : cases)
+      std::cout << c.entry.index << "\t" << c.entry.id << "\t" << c.entry.sweep << "\t" << c.entry.label() << "\n";
+    return 0;
+  }
+  const std::string out = args.require("--out");
+  const int jobs = jobs_flag(args);
+  std::error_code ec;
+  std::filesystem::create_directories(out, ec);
+  if (ec) throw UsageError("--out " + out + ": cannot create folder: " + ec.message());
+
+  std::cout << "matrix: " << file.name << ": " << expansion.cases.size() << " cases";
+  if (!filter.empty()) std::cout << ", " << filtered.size() << " match --filter '" << filter << "'";
+  if (shard_n > 1) std::cout << ", shard " << shard_k << "/" << shard_n << " has " << cases.size();
+  std::cout << "; " << jobs << " jobs; results in " << out << "\n";
+  for (const auto& n : expansion.notes) std::cout << "  note: " << n << "\n";
+
+  Provenance prov = collect_provenance();
+  prov.emplace_back("matrix_file", file.name);
+  prov.emplace_back("matrix_cases", std::to_string(expansion.cases.size()));
+  prov.emplace_back("filter", filter);
+  prov.emplace_back("shard", std::to_string(shard_k) + "/" + std::to_string(shard_n));
+  prov.emplace_back("cases_in_folder", std::to_string(cases.size()));
+  prov.emplace_back("jobs", std::to_string(jobs));
+  write_file_atomic(out + "/provenance.txt", format_provenance(prov));
+
+  MatrixRunOptions opt;
+  opt.out_dir = out;
+  opt.jobs = jobs;
+  opt.force = args.has("--force");
+  opt.binary_id = binary_identity();
+  opt.matrix_text = file.text;
+  opt.selected_cases = filtered.size();
+  opt.find_problem = [](const std::string& name) -> const Problem& { return find_problem(name); };
+  const bool tty = ::isatty(STDOUT_FILENO);
+  const MatrixRunStats stats = run_matrix(cases, opt, std::cout, tty);
+  write_matrix_summary(out, [&] {
+    std::vector<CaseEntry> entries;
+    for (const auto& c : cases) entries.push_back(c.entry);
+    return entries;
+  }());
+  // Outcomes over the whole folder, cached cases included.
+  std::map<std::string, size_t> outcomes;
+  const CsvTable summary = read_csv(out + "/summary.csv");
+  for (size_t r = 0; r < summary.rows.size(); ++r)
+    if (summary.get(r, "repeat") == "0") ++outcomes[summary.get(r, "status")];
+  std::string outcome_text;
+  for (const auto& [status, n] : outcomes)
+    outcome_text += (outcome_text.empty() ? "" : ", ") + std::to_string(n) + " " +
+                    (status == "invalid" ? std::string("not applicable") : status);
+  char secs[32];
+  std::snprintf(secs, sizeof secs, "%.1f", stats.seconds);
+  std::cout << "matrix: " << stats.total << " cases: " << stats.run << " run, " << stats.cached << " cached, in "
+            << secs << " s; " << (outcome_text.empty() ? "no results" : outcome_text) << "; " << out
+            << "/summary.csv\n";
+  if (shard_n > 1)
+    std::cout << "matrix: shard " << shard_k << "/" << shard_n << " done; join the shards with `cstab merge OUT "
+              << "SHARD_DIR...`\n";
+  else if (!args.has("--no-report"))
+    finish(out, jobs, true);
+  return 0;
+}
+
+int cmd_merge(const std::vector<std::string>& argv) {
+  Args args(argv, {"--jobs"}, {"--no-report"});
+  const auto& pos = args.positional();
+  if (pos.size() < 2) throw UsageError("merge: usage: cstab merge OUT SHARD_DIR... (at least one shard folder)");
+  const std::vector<std::string> shards(pos.begin() + 1, pos.end());
+  const size_t missing = merge_results(pos[0], shards, std::cout);
+  if (!args.has("--no-report")) finish(pos[0], jobs_flag(args), true);
+  if (missing) {
+    std::cerr << "cstab merge: " << missing << " cases of the matrix are missing from the shards (exit code 3)\n";
+    return 3;
+  }
+  return 0;
+}
+
+int cmd_report(const std::vector<std::string>& argv) {
+  Args args(argv, {"--jobs"}, {"--no-plots"});
+  if (args.positional().size() != 1) throw UsageError("report: usage: cstab report DIR [--jobs N] [--no-plots]");
+  const std::string dir = args.positional()[0];
+  std::vector<CaseEntry> entries;
+  try {
+    entries = read_manifest(dir + "/cases.csv");
+  } catch (const std::runtime_error& e) {
+    throw UsageError(dir + ": not a matrix results folder (" + e.what() + ")");
+  }
+  std::sort(entries.begin(), entries.end(), [](const CaseEntry& a, const CaseEntry& b) { return a.index < b.index; });
+  write_matrix_summary(dir, entries);
+  finish(dir, jobs_flag(args), !args.has("--no-plots"));
+  return 0;
+}
+
+}  // namespace cstab::cli

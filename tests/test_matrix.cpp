@@ -1,0 +1,335 @@
+// The benchmark matrix: parser errors name file:line:column, expansion is
+// deterministic, shards partition the cases, two shards run through GNU
+// parallel and merged equal one single-process run (timing columns aside),
+// an unchanged re-run runs nothing, and the report opens in a real browser
+// with every picture loaded.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <set>
+#include <sstream>
+
+#include "cli/matrix_commands.hpp"
+#include "harness/matrix.hpp"
+#include "methods/dispatch.hpp"
+#include "problems/registry.hpp"
+
+namespace cstab {
+namespace {
+
+namespace fs = std::filesystem;
+
+MatrixCatalog registry_catalog() {
+  MatrixCatalog c;
+  for (const auto& p : all_problems()) c.problems.push_back(p.get());
+  c.methods = all_methods();
+  return c;
+}
+
+// The message of the MatrixError that parsing + expanding `text` throws.
+std::string error_of(const std::string& text) {
+  try {
+    expand_matrix(parse_matrix(text, "m.toml"), registry_catalog());
+  } catch (const MatrixError& e) {
+    return e.what();
+  }
+  return "(no error)";
+}
+
+const char* kSweepHead = "[[sweep]]\nproblems = [\"wheel\"]\nmethods = [\"pesterev\", \"minimal\"]\n";
+
+TEST(MatrixParse, ErrorsNameFileLineAndColumn) {
+  // Syntax.
+  EXPECT_EQ(error_of("[[sweep]]\nstep = [1e-3, abc]\n").substr(0, 13), "m.toml:2:15: ") << error_of("[[sweep]]\nstep = [1e-3, abc]\n");
+  EXPECT_NE(error_of("[[sweep]]\nstep = [1e-3, abc]\n").find("strings are quoted"), std::string::npos);
+  EXPECT_EQ(error_of("[[sweep]]\nname = \"open\n").substr(0, 12), "m.toml:2:8: ");
+  EXPECT_NE(error_of("[[sweep]]\nname = \"open\n").find("unterminated string"), std::string::npos);
+  EXPECT_EQ(error_of("[[sweep]]\nstep = [1e-3,\n  2e-3\n").substr(0, 12), "m.toml:2:8: ");
+  EXPECT_NE(error_of("[[sweep]]\nstep = [1e-3,\n  2e-3\n").find("missing ']'"), std::string::npos);
+  EXPECT_EQ(error_of("[sweep]\n").substr(0, 12), "m.toml:1:2: ");
+  EXPECT_NE(error_of("[sweep]\n").find("[[sweep]]"), std::string::npos);
+  EXPECT_EQ(error_of("step = 1\n").substr(0, 12), "m.toml:1:1: ");
+  EXPECT_EQ(error_of("[[sweep]]\nrepeats = 2 3\n").substr(0, 13), "m.toml:2:13: ");
+  EXPECT_NE(error_of("[[sweep]]\nt_end = 1\nt_end = 2\n").find("m.toml:3:1: duplicate key 't_end' (first given at line 2)"),
+            std::string::npos);
+  // Meaning.
+  const std::string unknown_key = error_of(std::string(kSweepHead) + "integrators = [\"rk4\"]\nstep = 1e-3\n  problem = \"x\"\n");
+  EXPECT_EQ(unknown_key.substr(0, 12), "m.toml:6:3: ") << unknown_key;
+  EXPECT_NE(unknown_key.find("did you mean 'problems'"), std::string::npos) << unknown_key;
+  const std::string unknown_problem = error_of("[[sweep]]\nproblems = [\"wheel\", \"wheeel\"]\nmethods = \"all\"\n"
+                                               "integrators = [\"rk4\"]\nstep = 1e-3\n");
+  EXPECT_EQ(unknown_problem.substr(0, 13), "m.toml:2:22: ") << unknown_problem;
+  EXPECT_NE(unknown_problem.find("did you mean 'wheel'"), std::string::npos) << unknown_problem;
+  const std::string no_step = error_of(std::string(kSweepHead) + "integrators = [\"rk8pd\", \"rk4\"]\ntol = 1e-8\n");
+  EXPECT_EQ(no_step.substr(0, 12), "m.toml:4:1: ") << no_step;
+  EXPECT_NE(no_step.find("'rk4' is fixed-step"), std::string::npos) << no_step;
+  const std::string bad_t_end =
+      error_of(std::string(kSweepHead) + "integrators = \"rk4\"\nstep = 1e-3\nt_end = [1, \"later\"]\n");
+  EXPECT_EQ(bad_t_end.substr(0, 13), "m.toml:6:13: ") << bad_t_end;
+  const std::string bad_param = error_of(std::string(kSweepHead) +
+                                         "integrators = \"rk4\"\nstep = 1e-3\nparam.pesterev.lambdaa = 5\n");
+  EXPECT_EQ(bad_param.substr(0, 12), "m.toml:6:1: ") << bad_param;
+  EXPECT_NE(bad_param.find("no parameter 'lambdaa'"), std::string::npos) << bad_param;
+}
+
+TEST(MatrixParse, ReadsTheTomlSubset) {
+  const MatrixFile f = parse_matrix(
+      "# comment\n[defaults]\nrepeats = 2 # trailing\n\n[[sweep]]\nname = 'literal'\n"
+      "step = [\n  1e-3,  # first\n  5_000e-7,\n]\nparam.pesterev.lambda = 1500\nseries = false\n",
+      "f.toml");
+  ASSERT_EQ(f.sections.size(), 2u);
+  EXPECT_EQ(f.sections[0].kind, "defaults");
+  const auto& e = f.sections[1].entries;
+  ASSERT_EQ(e.size(), 4u);
+  EXPECT_EQ(e[0].value.text, "literal");
+  ASSERT_EQ(e[1].value.items.size(), 2u);
+  EXPECT_DOUBLE_EQ(e[1].value.items[1].number, 5e-4);
+  EXPECT_EQ(e[1].value.items[1].where.line, 9);
+  EXPECT_EQ(e[2].key, "param.pesterev.lambda");
+  EXPECT_FALSE(e[3].value.boolean);
+}
+
+const char* kSmall = R"([defaults]
+problems = ["wheel"]
+methods = ["pesterev", "minimal"]
+t_end = 1
+ref_time = 1
+
+[[sweep]]
+name = "fixed"
+integrators = ["rk4", "adams"]
+step = [1e-3, 5e-4]
+param.lambda = [500, 1500]
+
+[[sweep]]
+name = "adaptive"
+integrators = "rk8pd"
+tol = [1e-6, 1e-8]
+repeats = 2
+)";
+
+TEST(MatrixExpand, IsDeterministicAndAppliesParametersOnlyWhereDeclared) {
+  const auto a = expand_matrix(parse_matrix(kSmall, "s.toml"), registry_catalog());
+  const auto b = expand_matrix(parse_matrix(kSmall, "s.toml"), registry_catalog());
+  // fixed: pesterev 2 integrators x 2 steps x 2 lambdas + minimal 2 x 2; adaptive: 2 methods x 2 tols.
+  ASSERT_EQ(a.cases.size(), 8u + 4u + 4u);
+  std::set<std::string> ids;
+  for (size_t i = 0; i < a.cases.size(); ++i) {
+    EXPECT_EQ(a.cases[i].entry.id, b.cases[i].entry.id);
+    EXPECT_EQ(a.cases[i].entry.index, i);
+    ids.insert(a.cases[i].entry.id);
+    if (a.cases[i].entry.method == "minimal") {
+      EXPECT_EQ(a.cases[i].entry.params, "");
+    }
+    if (a.cases[i].entry.method == "pesterev" && a.cases[i].entry.sweep == "fixed") {
+      EXPECT_EQ(a.cases[i].entry.params.rfind("lambda=", 0), 0u);
+    }
+  }
+  EXPECT_EQ(ids.size(), a.cases.size());
+  EXPECT_EQ(a.cases[0].entry.label(), "wheel pesterev rk4 step=0.001 t_end=1 lambda=500");
+  EXPECT_EQ(a.cases.back().entry.label(), "wheel minimal rk8pd tol=1e-08 t_end=1 x2");
+  // The id depends on the configuration only: a case keeps it in another matrix.
+  const auto one = expand_matrix(parse_matrix("[[sweep]]\nname = \"other\"\nproblems = \"wheel\"\nmethods = \"minimal\"\n"
+                                              "integrators = \"rk8pd\"\ntol = 1e-8\nt_end = 1\nref_time = 1\nrepeats = 2\n",
+                                              "o.toml"),
+                                 registry_catalog());
+  ASSERT_EQ(one.cases.size(), 1u);
+  EXPECT_EQ(one.cases[0].entry.id, a.cases.back().entry.id);
+}
+
+TEST(MatrixExpand, ShardsPartitionTheCases) {
+  const auto all = expand_matrix(parse_matrix(kSmall, "s.toml"), registry_catalog()).cases;
+  for (int n : {1, 2, 3, 5}) {
+    std::multiset<size_t> seen;
+    for (int k = 1; k <= n; ++k) {
+      const auto shard = select_cases(all, "", k, n);
+      EXPECT_LE(shard.size(), all.size() / n + 1);
+      for (size_t i = 1; i < shard.size(); ++i) EXPECT_LT(shard[i - 1].entry.index, shard[i].entry.index);
+      for (const auto& c : shard) seen.insert(c.entry.index);
+      // Same answer every time.
+      const auto again = select_cases(all, "", k, n);
+      ASSERT_EQ(again.size(), shard.size());
+      for (size_t i = 0; i < shard.size(); ++i) EXPECT_EQ(again[i].entry.id, shard[i].entry.id);
+    }
+    ASSERT_EQ(seen.size(), all.size()) << n << " shards";
+    for (size_t i = 0; i < all.size(); ++i) EXPECT_EQ(seen.count(i), 1u);
+  }
+  EXPECT_THROW(parse_shard("0/4"), UsageError);
+  EXPECT_THROW(parse_shard("5/4"), UsageError);
+  EXPECT_THROW(parse_shard("2"), UsageError);
+  EXPECT_EQ(parse_shard("3/4"), std::make_pair(3, 4));
+}
+
+TEST(MatrixExpand, DefaultMatrixCoversEveryApplicableProblemMethodPair) {
+  const auto ex = expand_matrix(parse_matrix(cli::default_matrix_text(), "<default>"), registry_catalog());
+  std::set<std::pair<std::string, std::string>> covered;
+  for (const auto& c : ex.cases) covered.insert({c.entry.problem, c.entry.method});
+  for (const auto& p : all_problems())
+    for (const auto& m : all_methods())
+      if (p->why_not(m.name).empty()) {
+        EXPECT_TRUE(covered.count({p->info().name, m.name})) << p->info().name << " x " << m.name;
+      }
+}
+
+// ---------------------------------------------------------------------------
+// Runs of the binary.
+
+struct Output {
+  int code;
+  std::string text;
+};
+
+Output sh(const std::string& command) {
+  Output out{-1, ""};
+  std::FILE* p = ::popen((command + " 2>&1").c_str(), "r");
+  if (!p) return out;
+  char buf[4096];
+  size_t n;
+  while ((n = std::fread(buf, 1, sizeof buf, p)) > 0) out.text.append(buf, n);
+  const int status = ::pclose(p);
+  out.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return out;
+}
+
+std::string slurp(const std::string& path) {
+  std::ifstream in(path);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+// summary.csv without the timing columns.
+std::string without_timing(const std::string& path) {
+  const CsvTable t = read_csv(path);
+  std::string out;
+  std::vector<size_t> keep;
+  for (size_t i = 0; i < t.header.size(); ++i)
+    if (t.header[i] != "wall_seconds" && t.header[i] != "observe_seconds") keep.push_back(i);
+  for (size_t i : keep) out += t.header[i] + ",";
+  out += "\n";
+  for (const auto& row : t.rows) {
+    for (size_t i : keep) out += (i < row.size() ? row[i] : "") + ",";
+    out += "\n";
+  }
+  return out;
+}
+
+class MatrixRun : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    char tmpl[] = "/tmp/cstab-test-matrix-XXXXXX";
+    dir_ = ::mkdtemp(tmpl);
+    std::ofstream(dir_ + "/tiny.toml") << R"(# the tests' matrix: a few fast wheel cases
+[defaults]
+problems = ["wheel"]
+methods = "all"
+t_end = 0.5
+ref_time = 0.5
+repeats = 2
+
+[[sweep]]
+name = "fixed"
+integrators = "rk4"
+step = [1e-3, 5e-4]
+methods = ["pesterev", "minimal"]
+
+[[sweep]]
+name = "adaptive"
+integrators = "rk8pd"
+tol = [1e-6, 1e-9]
+methods = ["pesterev", "minimal"]
+
+[[sweep]]
+name = "long"
+integrators = "rk8pd"
+tol = 1e-8
+t_end = 1
+repeats = 1
+work_precision = false
+overlay = true
+methods = ["pesterev", "minimal"]
+)";
+    single_ = sh(std::string(CSTAB_BINARY) + " matrix " + dir_ + "/tiny.toml --out " + dir_ + "/single --jobs 2");
+  }
+  static void TearDownTestSuite() {
+    if (!::testing::Test::HasFailure()) fs::remove_all(dir_);
+  }
+  static std::string dir_;
+  static Output single_;
+};
+std::string MatrixRun::dir_;
+Output MatrixRun::single_;
+
+TEST_F(MatrixRun, SingleRunWritesResultsPlotsAndReport) {
+  ASSERT_EQ(single_.code, 0) << single_.text;
+  EXPECT_NE(single_.text.find("10 cases: 10 run, 0 cached, in "), std::string::npos) << single_.text;
+  for (const char* f : {"summary.csv", "cases.csv", "matrix.toml", "provenance.txt", "work_precision.csv",
+                        "fastest.csv", "report.html", "plots/wheel_work_precision.png", "plots/wheel_work_precision.svg",
+                        "plots/wheel_overlay.png", "plots/wheel_trajectory.svg"})
+    EXPECT_TRUE(fs::exists(dir_ + "/single/" + f)) << f;
+  const CsvTable s = read_csv(dir_ + "/single/summary.csv");
+  EXPECT_EQ(s.header[0], "case_id");
+  EXPECT_EQ(s.header[1], "repeat");
+  EXPECT_EQ(s.header[2], "sweep");
+  EXPECT_EQ(s.rows.size(), 8u * 2 + 2);  // repeats
+  const std::string prov = slurp(dir_ + "/single/provenance.txt");
+  for (const char* key : {"git_revision: ", "compiler: ", "cxx_flags: ", "eigen: 3.", "gsl: ", "sundials: ", "cpu: ",
+                          "date: "})
+    EXPECT_NE(prov.find(key), std::string::npos) << key;
+  const std::string html = slurp(dir_ + "/single/report.html");
+  EXPECT_NE(html.find("data:image/png;base64,"), std::string::npos);
+  EXPECT_NE(html.find("Fastest method at each accuracy level"), std::string::npos);
+}
+
+TEST_F(MatrixRun, UnchangedRerunRunsNothing) {
+  ASSERT_EQ(single_.code, 0) << single_.text;
+  const std::string before = slurp(dir_ + "/single/summary.csv");
+  const auto start = std::chrono::steady_clock::now();
+  const Output again = sh(std::string(CSTAB_BINARY) + " matrix " + dir_ + "/tiny.toml --out " + dir_ + "/single");
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  ASSERT_EQ(again.code, 0) << again.text;
+  EXPECT_NE(again.text.find("10 of 10 cases cached"), std::string::npos) << again.text;
+  EXPECT_NE(again.text.find("0 run, 10 cached"), std::string::npos) << again.text;
+  EXPECT_NE(again.text.find("0 plots drawn"), std::string::npos) << again.text;
+  EXPECT_EQ(slurp(dir_ + "/single/summary.csv"), before);  // nothing rerun: even the timings are the same
+  EXPECT_LT(seconds, 5.0);
+}
+
+TEST_F(MatrixRun, TwoShardsThroughGnuParallelMergeToTheSingleRun) {
+  ASSERT_EQ(single_.code, 0) << single_.text;
+  ASSERT_EQ(sh("command -v parallel").code, 0) << "GNU parallel is not installed (scripts/install-deps.sh)";
+  const Output shards = sh("cd " + dir_ + " && parallel --will-cite " + CSTAB_BINARY +
+                           " matrix tiny.toml --shard {}/2 --out shard{} --jobs 1 ::: 1 2");
+  ASSERT_EQ(shards.code, 0) << shards.text;
+  const size_t n1 = read_csv(dir_ + "/shard1/cases.csv").rows.size();
+  const size_t n2 = read_csv(dir_ + "/shard2/cases.csv").rows.size();
+  EXPECT_EQ(n1 + n2, 10u);
+  EXPECT_GE(n1, 4u);
+  EXPECT_GE(n2, 4u);
+  const Output merge = sh(std::string(CSTAB_BINARY) + " merge " + dir_ + "/merged " + dir_ + "/shard1 " + dir_ +
+                          "/shard2 --no-report");
+  ASSERT_EQ(merge.code, 0) << merge.text;
+  EXPECT_EQ(without_timing(dir_ + "/merged/summary.csv"), without_timing(dir_ + "/single/summary.csv"));
+  EXPECT_EQ(slurp(dir_ + "/merged/cases.csv"), slurp(dir_ + "/single/cases.csv"));
+  // A missing shard is reported, with exit code 3.
+  const Output partial = sh(std::string(CSTAB_BINARY) + " merge " + dir_ + "/partial " + dir_ + "/shard1 --no-report");
+  EXPECT_EQ(partial.code, 3) << partial.text;
+}
+
+TEST_F(MatrixRun, ReportOpensInHeadlessChromiumWithEveryImageLoaded) {
+  ASSERT_EQ(single_.code, 0) << single_.text;
+  const Output check = sh("bash " CSTAB_SOURCE_DIR "/scripts/check-report.sh " + dir_ + "/single " + dir_ + "/shot.png");
+  if (check.code == 77) GTEST_SKIP() << check.text;
+  ASSERT_EQ(check.code, 0) << check.text;
+  EXPECT_NE(check.text.find("images loaded"), std::string::npos) << check.text;
+  EXPECT_TRUE(fs::exists(dir_ + "/shot.png"));
+}
+
+}  // namespace
+}  // namespace cstab
