@@ -1,0 +1,390 @@
+// The cstab binary as a user sees it: bad input gives exit code 2, a
+// one-line message naming the bad flag, and no output files; a good run
+// writes summary.csv and series.csv with the documented columns.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace fs = std::filesystem;
+
+namespace {
+
+std::string quote(const std::string& s) {
+  std::string out = "'";
+  for (char c : s) {
+    if (c == '\'') out += "'\\''";
+    else out += c;
+  }
+  return out + "'";
+}
+
+std::string slurp(const fs::path& p) {
+  std::ifstream in(p);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+struct Outcome {
+  int code = -1;
+  std::string out, err;
+};
+
+// A scratch folder per test, removed afterwards.
+class Scratch {
+ public:
+  Scratch() {
+    std::string tmpl = (fs::temp_directory_path() / "cstab_cli_XXXXXX").string();
+    if (!::mkdtemp(tmpl.data())) throw std::runtime_error("mkdtemp failed");
+    dir_ = tmpl;
+  }
+  ~Scratch() {
+    std::error_code ec;
+    fs::remove_all(dir_, ec);
+  }
+  const fs::path& dir() const { return dir_; }
+
+ private:
+  fs::path dir_;
+};
+
+Outcome run_cli(const std::vector<std::string>& args, const fs::path& scratch) {
+  std::string cmd = quote(CSTAB_BINARY);
+  for (const auto& a : args) cmd += " " + quote(a);
+  const fs::path out = scratch / "stdout.txt", err = scratch / "stderr.txt";
+  cmd += " >" + quote(out.string()) + " 2>" + quote(err.string());
+  const int status = std::system(cmd.c_str());
+  Outcome o;
+  o.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  o.out = slurp(out);
+  o.err = slurp(err);
+  return o;
+}
+
+// Output files or temporaries anywhere below `dir`.
+std::vector<std::string> leftovers(const fs::path& dir) {
+  std::vector<std::string> found;
+  std::error_code ec;
+  if (!fs::exists(dir, ec) || !fs::is_directory(dir, ec)) return found;
+  for (const auto& e : fs::recursive_directory_iterator(dir, ec)) {
+    const std::string name = e.path().filename().string();
+    if (name == "summary.csv" || name == "series.csv" || name.find(".tmp.") != std::string::npos)
+      found.push_back(e.path().string());
+  }
+  return found;
+}
+
+std::vector<std::string> split(const std::string& line, char sep = ',') {
+  std::vector<std::string> out;
+  std::string cur;
+  for (char c : line) {
+    if (c == sep) {
+      out.push_back(cur);
+      cur.clear();
+    } else {
+      cur += c;
+    }
+  }
+  out.push_back(cur);
+  return out;
+}
+
+struct Csv {
+  std::vector<std::string> header;
+  std::vector<std::vector<std::string>> rows;
+  int col(const std::string& name) const {
+    for (size_t i = 0; i < header.size(); ++i)
+      if (header[i] == name) return int(i);
+    return -1;
+  }
+};
+
+// Plain CSV (the harness quotes only fields with commas; the series has none).
+Csv read_csv(const fs::path& p) {
+  Csv c;
+  std::ifstream in(p);
+  std::string line;
+  if (std::getline(in, line)) c.header = split(line);
+  while (std::getline(in, line))
+    if (!line.empty()) c.rows.push_back(split(line));
+  return c;
+}
+
+double num(const std::string& s) { return s.empty() ? std::nan("") : std::strtod(s.c_str(), nullptr); }
+
+// ---------------------------------------------------------------------------
+
+struct BadCase {
+  std::string label;
+  std::vector<std::string> args;  // everything but --out
+  std::string names;              // the message must contain this
+};
+
+const std::vector<std::string> kGood = {"run", "--problem", "wheel", "--method", "pesterev", "--integrator", "rk4",
+                                        "--step", "1e-3", "--t-end", "0.05"};
+
+std::vector<std::string> with(std::vector<std::string> base, const std::string& flag, const std::string& value) {
+  for (size_t i = 0; i + 1 < base.size(); ++i)
+    if (base[i] == flag) {
+      base[i + 1] = value;
+      return base;
+    }
+  base.push_back(flag);
+  base.push_back(value);
+  return base;
+}
+std::vector<std::string> without(std::vector<std::string> base, const std::string& flag) {
+  for (size_t i = 0; i + 1 < base.size(); ++i)
+    if (base[i] == flag) {
+      base.erase(base.begin() + long(i), base.begin() + long(i) + 2);
+      break;
+    }
+  return base;
+}
+
+std::vector<BadCase> bad_cases() {
+  std::vector<std::string> adaptive = with(without(kGood, "--step"), "--integrator", "rk8pd");
+  adaptive = with(with(adaptive, "--rtol", "1e-6"), "--atol", "1e-6");
+  return {
+      {"unknown_problem", with(kGood, "--problem", "no-such-problem"), "--problem"},
+      {"unknown_method", with(kGood, "--method", "no-such-method"), "--method"},
+      {"unknown_integrator", with(kGood, "--integrator", "no-such-integrator"), "--integrator"},
+      {"unknown_param", with(kGood, "--param", "no_such_param=1"), "--param no_such_param"},
+      {"param_without_value", with(kGood, "--param", "lambda"), "--param"},
+      {"step_zero", with(kGood, "--step", "0"), "--step"},
+      {"step_negative", with(kGood, "--step", "-1"), "--step"},
+      {"step_nan", with(kGood, "--step", "nan"), "--step"},
+      {"step_inf", with(kGood, "--step", "inf"), "--step"},
+      {"step_garbage", with(kGood, "--step", "1e-3x"), "--step"},
+      {"t_end_zero", with(kGood, "--t-end", "0"), "--t-end"},
+      {"t_end_nan", with(kGood, "--t-end", "nan"), "--t-end"},
+      {"t_end_negative", with(kGood, "--t-end", "-2"), "--t-end"},
+      {"lambda_negative", with(kGood, "--param", "lambda=-5"), "--param lambda"},
+      {"lambda_zero", with(kGood, "--param", "lambda=0"), "--param lambda"},
+      {"lambda_nan", with(kGood, "--param", "lambda=nan"), "--param lambda"},
+      {"missing_step_for_rk4", without(kGood, "--step"), "--step"},
+      {"step_for_rk8pd", with(adaptive, "--step", "1e-3"), "--step"},
+      {"missing_rtol_for_rk8pd", without(adaptive, "--rtol"), "--rtol"},
+      {"rtol_nan", with(adaptive, "--rtol", "nan"), "--rtol"},
+      {"param_for_minimal", with(with(kGood, "--method", "minimal"), "--param", "lambda=3"), "--param lambda"},
+      {"times_beyond_t_end", with(kGood, "--times", "0.5"), "--times"},
+      {"times_negative", with(kGood, "--times", "-0.01"), "--times"},
+      {"unknown_option", with(kGood, "--no-such-option", "1"), "--no-such-option"},
+      {"missing_problem", without(kGood, "--problem"), "--problem"},
+  };
+}
+
+class BadInput : public ::testing::TestWithParam<BadCase> {};
+
+TEST_P(BadInput, ExitsTwoWithOneLineNamingTheFlagAndWritesNothing) {
+  const BadCase& c = GetParam();
+  Scratch s;
+  // An existing, writable output folder: if anything were written, it
+  // would be found here.
+  const fs::path out = s.dir() / "out";
+  fs::create_directories(out);
+  auto args = c.args;
+  args.push_back("--out");
+  args.push_back(out.string());
+  const Outcome o = run_cli(args, s.dir());
+  EXPECT_EQ(o.code, 2) << "stderr: " << o.err;
+  ASSERT_FALSE(o.err.empty());
+  EXPECT_EQ(o.err.back(), '\n');
+  EXPECT_EQ(std::count(o.err.begin(), o.err.end(), '\n'), 1) << "not one line: " << o.err;
+  EXPECT_NE(o.err.find(c.names), std::string::npos) << "message does not name '" << c.names << "': " << o.err;
+  EXPECT_TRUE(leftovers(out).empty()) << leftovers(out).front();
+}
+
+INSTANTIATE_TEST_SUITE_P(Cli, BadInput, ::testing::ValuesIn(bad_cases()),
+                         [](const auto& info) { return info.param.label; });
+
+TEST(Cli, UnwritableOutUnderProc) {
+  Scratch s;
+  auto args = kGood;
+  args.insert(args.end(), {"--out", "/proc/cstab_x"});
+  const Outcome o = run_cli(args, s.dir());
+  EXPECT_EQ(o.code, 2) << o.err;
+  EXPECT_EQ(std::count(o.err.begin(), o.err.end(), '\n'), 1) << o.err;
+  EXPECT_NE(o.err.find("--out"), std::string::npos) << o.err;
+  EXPECT_FALSE(fs::exists("/proc/cstab_x"));
+}
+
+TEST(Cli, UnwritableOutUnderARegularFile) {
+  Scratch s;
+  const fs::path file = s.dir() / "plain";
+  std::ofstream(file) << "x\n";
+  for (const fs::path out : {file / "sub", file}) {
+    SCOPED_TRACE(out.string());
+    auto args = kGood;
+    args.insert(args.end(), {"--out", out.string()});
+    const Outcome o = run_cli(args, s.dir());
+    EXPECT_EQ(o.code, 2) << o.err;
+    EXPECT_EQ(std::count(o.err.begin(), o.err.end(), '\n'), 1) << o.err;
+    EXPECT_NE(o.err.find("--out"), std::string::npos) << o.err;
+    EXPECT_EQ(slurp(file), "x\n");
+    EXPECT_TRUE(leftovers(s.dir()).empty()) << leftovers(s.dir()).front();
+  }
+}
+
+// An existing folder that cannot take files, with --no-series: the folder
+// must be found unwritable before the run (exit 2), not after it.
+// DISABLED: fails today (exit 1 after the whole integration), see the fix
+// proposed for harness/run.cpp (probe the summary file before integrating).
+TEST(Cli, DISABLED_UnwritableOutWithoutSeries) {
+  Scratch s;
+  auto args = kGood;
+  args.insert(args.end(), {"--no-series", "--out", "/proc"});
+  const Outcome o = run_cli(args, s.dir());
+  EXPECT_EQ(o.code, 2) << o.err;
+  EXPECT_EQ(std::count(o.err.begin(), o.err.end(), '\n'), 1) << o.err;
+  EXPECT_NE(o.err.find("--out"), std::string::npos) << o.err;
+}
+
+TEST(Cli, NoArgumentsPrintsUsageAndExitsTwo) {
+  Scratch s;
+  const Outcome o = run_cli({}, s.dir());
+  EXPECT_EQ(o.code, 2);
+  EXPECT_NE(o.out.find("usage"), std::string::npos);
+  const Outcome u = run_cli({"frobnicate"}, s.dir());
+  EXPECT_EQ(u.code, 2);
+  EXPECT_NE(u.err.find("frobnicate"), std::string::npos);
+}
+
+// ---------------------------------------------------------------------------
+// A good run
+
+const std::vector<std::string> kSeriesPrefix = {
+    "t",     "x",        "xdot",  "z",                "zdot",             "theta",
+    "thetadot", "phi",   "phidot", "alpha",           "residual_contact", "residual_rolling",
+    "residual_tangency", "energy_drift"};
+
+const std::vector<std::string> kSummaryColumns = {
+    "problem", "formulation", "method", "params", "integrator", "step", "rtol", "atol", "status", "reason",
+    "fail_time", "t_end", "t_reached", "steps", "rejected_steps", "rhs_evals", "wall_seconds",
+    "observe_seconds", "max_residual", "final_residual", "max_energy_drift", "final_energy_drift", "energy_law",
+    "max_condition", "ref_time", "ref_error", "ref_scd", "max_residual_contact", "max_residual_rolling",
+    "max_residual_tangency", "final_residual_contact", "final_residual_rolling", "final_residual_tangency"};
+
+TEST(Cli, GoodRunWritesDocumentedFiles) {
+  Scratch s;
+  const fs::path out = s.dir() / "nested" / "run";  // created by cstab
+  auto args = with(kGood, "--t-end", "0.5");
+  args.insert(args.end(), {"--times", "0.1234,0.25", "--times", "0.3337", "--out", out.string()});
+  const Outcome o = run_cli(args, s.dir());
+  ASSERT_EQ(o.code, 0) << o.err;
+  EXPECT_TRUE(o.err.empty()) << o.err;
+  ASSERT_TRUE(fs::exists(out / "summary.csv"));
+  ASSERT_TRUE(fs::exists(out / "series.csv"));
+  for (const auto& e : fs::directory_iterator(out))
+    EXPECT_EQ(e.path().filename().string().find(".tmp."), std::string::npos) << e.path();
+
+  // summary.csv: one header, one row, every documented column.
+  const Csv sum = read_csv(out / "summary.csv");
+  ASSERT_EQ(sum.rows.size(), 1u);
+  for (const auto& c : kSummaryColumns) EXPECT_GE(sum.col(c), 0) << "summary lacks " << c;
+  auto get = [&](const std::string& c) { return sum.col(c) >= 0 ? sum.rows[0][size_t(sum.col(c))] : ""; };
+  // params contains ';' but no comma: a plain split is fine.
+  ASSERT_EQ(sum.rows[0].size(), sum.header.size());
+  EXPECT_EQ(get("problem"), "wheel");
+  EXPECT_EQ(get("formulation"), "state-space");
+  EXPECT_EQ(get("method"), "pesterev");
+  EXPECT_EQ(get("integrator"), "rk4");
+  EXPECT_EQ(get("status"), "ok");
+  EXPECT_EQ(get("energy_law"), "yes");
+  EXPECT_EQ(num(get("step")), 1e-3);
+  EXPECT_EQ(get("rtol"), "");
+  EXPECT_EQ(num(get("t_reached")), 0.5);
+  EXPECT_EQ(num(get("steps")), 500);
+  EXPECT_NE(get("params").find("lambda=1500"), std::string::npos) << get("params");
+
+  // series.csv: the documented columns, in order.
+  const Csv ser = read_csv(out / "series.csv");
+  ASSERT_GE(ser.header.size(), kSeriesPrefix.size());
+  for (size_t i = 0; i < kSeriesPrefix.size(); ++i) EXPECT_EQ(ser.header[i], kSeriesPrefix[i]) << "column " << i;
+  ASSERT_GT(ser.rows.size(), 10u);
+  for (const auto& r : ser.rows) ASSERT_EQ(r.size(), ser.header.size());
+
+  // First row: t = 0, on the manifold, no energy drift.
+  EXPECT_EQ(num(ser.rows.front()[0]), 0.0);
+  EXPECT_EQ(num(ser.rows.front()[size_t(ser.col("energy_drift"))]), 0.0);
+  for (const char* c : {"residual_contact", "residual_rolling", "residual_tangency"})
+    EXPECT_LT(std::abs(num(ser.rows.front()[size_t(ser.col(c))])), 1e-15) << c;
+
+  // Rows at exactly the requested times and at t_end.
+  for (const char* t : {"0.1234", "0.25", "0.3337", "0.5"}) {
+    const double want = std::strtod(t, nullptr);
+    int hits = 0;
+    for (const auto& r : ser.rows) hits += num(r[0]) == want;
+    EXPECT_GE(hits, 1) << "no row at t = " << t;
+  }
+
+  // The summary agrees with the series: series residuals never exceed the
+  // recorded maxima, and the last row carries the final residuals.
+  for (const char* c : {"contact", "rolling", "tangency"}) {
+    const double mx = num(get(std::string("max_residual_") + c));
+    const double fin = num(get(std::string("final_residual_") + c));
+    const size_t col = size_t(ser.col(std::string("residual_") + c));
+    for (const auto& r : ser.rows) EXPECT_LE(std::abs(num(r[col])), mx) << c << " at t=" << r[0];
+    EXPECT_EQ(std::abs(num(ser.rows.back()[col])), fin) << c;
+  }
+  EXPECT_EQ(num(ser.rows.back()[0]), 0.5);
+  const double max_drift = num(get("max_energy_drift"));
+  for (const auto& r : ser.rows) EXPECT_LE(std::abs(num(r[size_t(ser.col("energy_drift"))])), max_drift);
+}
+
+// Output times between grid points are reached by a side step that does
+// not disturb the trajectory: the t_end row is identical with and without
+// --times, and an output time equals the final state of a run ending there.
+TEST(Cli, TimesDoNotDisturbTheTrajectory) {
+  Scratch s;
+  auto a = with(kGood, "--t-end", "0.4");
+  a.insert(a.end(), {"--times", "0.1234,0.2718", "--out", (s.dir() / "a").string()});
+  auto b = with(kGood, "--t-end", "0.4");
+  b.insert(b.end(), {"--out", (s.dir() / "b").string()});
+  auto c = with(kGood, "--t-end", "0.2718");
+  c.insert(c.end(), {"--out", (s.dir() / "c").string()});
+  ASSERT_EQ(run_cli(a, s.dir()).code, 0);
+  ASSERT_EQ(run_cli(b, s.dir()).code, 0);
+  ASSERT_EQ(run_cli(c, s.dir()).code, 0);
+  const Csv sa = read_csv(s.dir() / "a" / "series.csv");
+  const Csv sb = read_csv(s.dir() / "b" / "series.csv");
+  const Csv sc = read_csv(s.dir() / "c" / "series.csv");
+  ASSERT_FALSE(sa.rows.empty());
+  ASSERT_FALSE(sb.rows.empty());
+  ASSERT_FALSE(sc.rows.empty());
+  // Coordinates and residuals (not cond, which is a derived diagnostic).
+  for (size_t i = 0; i < kSeriesPrefix.size(); ++i) EXPECT_EQ(sa.rows.back()[i], sb.rows.back()[i]) << sa.header[i];
+  const std::vector<std::string>* at = nullptr;
+  for (const auto& r : sa.rows)
+    if (num(r[0]) == 0.2718) at = &r;
+  ASSERT_NE(at, nullptr);
+  for (size_t i = 0; i < kSeriesPrefix.size(); ++i) EXPECT_EQ((*at)[i], sc.rows.back()[i]) << sa.header[i];
+}
+
+// The series is a time series: strictly increasing t, one row per time.
+// DISABLED: fails today -- an output time that is a grid point gets two rows
+// (the step's sample row and the output row), and a grid point that lands
+// 1 ulp past an output time (0.7000000000000001 for 700 * 1e-3) precedes the
+// output row at 0.7. See the fix proposed for harness/run.cpp and
+// harness/integrator.cpp.
+TEST(Cli, DISABLED_SeriesTimesStrictlyIncrease) {
+  Scratch s;
+  auto a = with(kGood, "--t-end", "1");
+  a.insert(a.end(), {"--times", "0.1,0.3,0.35,0.7", "--out", s.dir().string()});
+  ASSERT_EQ(run_cli(a, s.dir()).code, 0);
+  const Csv ser = read_csv(s.dir() / "series.csv");
+  for (size_t i = 1; i < ser.rows.size(); ++i)
+    EXPECT_LT(num(ser.rows[i - 1][0]), num(ser.rows[i][0])) << "rows " << i - 1 << " and " << i;
+}
+
+}  // namespace
