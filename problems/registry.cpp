@@ -3,6 +3,7 @@
 
 #include "methods/dispatch.hpp"
 #include "problems/wheel.hpp"
+#include "problems/ball.hpp"
 #include "problems/slider_crank.hpp"
 #include "problems/andrews.hpp"
 #include "problems/car_axis.hpp"
@@ -13,6 +14,7 @@ const std::vector<std::unique_ptr<Problem>>& all_problems() {
   static const std::vector<std::unique_ptr<Problem>> list = [] {
     std::vector<std::unique_ptr<Problem>> v;
     v.push_back(std::make_unique<ProblemAdapter<Wheel>>(Wheel{}));
+    v.push_back(std::make_unique<ProblemAdapter<Ball>>(Ball{}));
     v.push_back(std::make_unique<ProblemAdapter<SliderCrank>>(SliderCrank{}));
     v.push_back(std::make_unique<ProblemAdapter<Andrews>>(Andrews{}));
     v.push_back(std::make_unique<ProblemAdapter<CarAxis>>(CarAxis{}));
