@@ -314,7 +314,7 @@ const std::vector<std::string>& known_keys() {
   static const std::vector<std::string> keys = {
       "name", "problems", "methods", "formulations", "integrators", "step", "tol", "rtol", "atol",
       "t_end", "ref_time", "times", "sample_every", "blowup", "observe_every", "series", "repeats",
-      "timeout", "work_precision", "overlay", "optional"};
+      "timeout", "repeat_if_under", "work_precision", "overlay", "optional"};
   return keys;
 }
 
@@ -474,7 +474,7 @@ double estimate_cost(const RunConfig& c, const IntegratorInfo& integ, int repeat
   return evals * repeats;
 }
 
-std::string canonical_text(const RunConfig& c, int repeats, double timeout) {
+std::string canonical_text(const RunConfig& c, int repeats, double timeout, double repeat_if_under) {
   std::string params;
   for (const auto& [k, v] : c.params) params += (params.empty() ? "" : ";") + k + "=" + v;
   std::string times;
@@ -486,7 +486,9 @@ std::string canonical_text(const RunConfig& c, int repeats, double timeout) {
     << "\nt_end=" << format_exact(c.t_end) << "\ntimes=" << times << "\nsample_every=" << format_exact(c.sample_every)
     << "\nref_time=" << format_exact(c.ref_time) << "\nblowup=" << format_exact(c.blowup)
     << "\nobserve_every=" << c.observe_every << "\nseries=" << (c.write_series ? 1 : 0) << "\nrepeats=" << repeats
-    << "\ntimeout=" << format_exact(timeout) << "\n";
+    << "\ntimeout=" << format_exact(timeout);
+  if (repeat_if_under > 0) s << "\nrepeat_if_under=" << format_exact(repeat_if_under);
+  s << "\n";
   return s.str();
 }
 
@@ -659,6 +661,7 @@ Expansion expand_matrix(const MatrixFile& file, const MatrixCatalog& catalog) {
     const double observe_every = set.number("observe_every", 1);
     const double repeats_num = set.number("repeats", 1);
     const double timeout = set.number("timeout", 0);
+    const double repeat_if_under = set.number("repeat_if_under", 0);
     auto check = [&](const char* key, bool ok, const std::string& what) {
       if (!ok) throw MatrixError(set.find(key)->value.where, std::string(key) + ": " + what);
     };
@@ -671,6 +674,8 @@ Expansion expand_matrix(const MatrixFile& file, const MatrixCatalog& catalog) {
       check("repeats", repeats_num >= 1 && repeats_num <= 1000 && repeats_num == std::floor(repeats_num),
             "must be an integer in [1, 1000]");
     if (set.find("timeout")) check("timeout", timeout >= 0, "must be >= 0 seconds (0: none)");
+    if (set.find("repeat_if_under"))
+      check("repeat_if_under", repeat_if_under >= 0, "must be >= 0 seconds (0: always repeat)");
     const int repeats = int(repeats_num);
     const bool series = set.boolean("series", true);
     const bool work_precision = set.boolean("work_precision", true);
@@ -786,7 +791,8 @@ Expansion expand_matrix(const MatrixFile& file, const MatrixCatalog& catalog) {
                   cfg.observe_every = int(observe_every);
                   cfg.write_series = series;
                   c.timeout = timeout;
-                  c.config_text = canonical_text(cfg, repeats, timeout);
+                  c.repeat_if_under = repeat_if_under;
+                  c.config_text = canonical_text(cfg, repeats, timeout, repeat_if_under);
                   CaseEntry& e = c.entry;
                   e.id = hash_hex(c.config_text);
                   if (!seen_ids.insert(e.id).second) {

@@ -107,6 +107,7 @@ struct MatrixCase {
   CaseEntry entry;
   RunConfig config;
   double timeout = 0;        // seconds, 0: none
+  double repeat_if_under = 0;  // repeat only while a run takes less (seconds); 0: always
   std::string config_text;   // canonical configuration; id = hash(config_text)
   double cost_estimate = 0;  // relative, for scheduling and shard balance
 };

@@ -122,6 +122,8 @@ int run_in_worker(const MatrixCase& c, const Problem& problem, const std::string
       code = result.status == "diverged" ? kExitDiverged : kExitFailed;
       break;
     }
+    // A long run is timed well enough once.
+    if (c.repeat_if_under > 0 && result.wall_seconds >= c.repeat_if_under) break;
   }
   write_result(dir, rows, key);
   return code;
@@ -263,9 +265,11 @@ MatrixRunStats run_matrix(const std::vector<MatrixCase>& cases, const MatrixRunO
     ++finished;
     cost_done += c.cost_estimate;
     std::ostringstream line;
-    char head[64];
-    std::snprintf(head, sizeof head, "[%zu/%zu] %-8s %7.2fs  ", stats.cached + finished, stats.total,
-                  outcome == "invalid" ? "n/a" : outcome.c_str(), seconds);
+    char head[96];
+    const double t = elapsed();
+    const std::string eta = finished == todo.size() ? "0:00" : clock_text(t * (cost_total - cost_done) / cost_done);
+    std::snprintf(head, sizeof head, "[%zu/%zu %s, ETA %s] %-8s %7.2fs  ", stats.cached + finished, stats.total,
+                  clock_text(t).c_str(), eta.c_str(), outcome == "invalid" ? "n/a" : outcome.c_str(), seconds);
     line << head << c.entry.label() << "  (" << c.entry.id << ")";
     if (!reason.empty() && outcome != "ok" && outcome != "diverged") line << "\n    " << reason;
     if (tty) {
@@ -280,8 +284,8 @@ MatrixRunStats run_matrix(const std::vector<MatrixCase>& cases, const MatrixRunO
     while (running.size() < jobs && next < todo.size()) {
       const MatrixCase& c = *todo[next++];
       const std::string dir = case_folder(opt.out_dir, c.entry.id);
+      fs::remove_all(dir, ec);  // nothing stale survives: incomplete until the worker writes key.txt
       fs::create_directories(dir, ec);
-      fs::remove(dir + "/key.txt", ec);  // incomplete until the worker writes it
       const std::string key = cache_key(c, opt.binary_id);
       const Problem& problem = opt.find_problem(c.config.problem);
       log.flush();

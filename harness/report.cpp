@@ -263,24 +263,26 @@ bool has_series(const std::string& dir, const CaseResult* c) {
   return c->complete && fs::exists(dir + "/cases/" + c->entry->id + "/series.csv");
 }
 
-// Overlay run per method: the first overlay-marked case with a series (ok
-// preferred), else the ok case with the longest horizon and the smallest
-// reference error.
+// Overlay run per method: the first overlay-marked case that finished
+// (status ok), else the finished case with the longest horizon (smallest
+// reference error among those), else the first overlay-marked case at all
+// (a diverged run shows how it diverged).
 std::vector<const CaseResult*> overlay_runs(const std::string& dir, const ProblemView& p) {
   std::vector<const CaseResult*> out;
   for (const auto& m : p.methods) {
     const CaseResult* pick = nullptr;
-    for (int pass = 0; pass < 2 && !pick; ++pass)
-      for (const CaseResult* c : p.cases)
-        if (!pick && c->entry->method == m && c->entry->overlay && has_series(dir, c) && (pass == 1 || c->ok()))
+    for (const CaseResult* c : p.cases)
+      if (!pick && c->entry->method == m && c->entry->overlay && c->ok() && has_series(dir, c)) pick = c;
+    if (!pick)
+      for (const CaseResult* c : p.cases) {
+        if (c->entry->method != m || !c->ok() || !has_series(dir, c)) continue;
+        if (!pick || c->entry->t_end > pick->entry->t_end ||
+            (c->entry->t_end == pick->entry->t_end && (std::isnan(pick->ref_error) || c->ref_error < pick->ref_error)))
           pick = c;
-    for (const CaseResult* c : p.cases) {
-      if (pick && pick->entry->overlay) break;
-      if (c->entry->method != m || !c->ok() || !has_series(dir, c)) continue;
-      if (!pick || c->entry->t_end > pick->entry->t_end ||
-          (c->entry->t_end == pick->entry->t_end && (std::isnan(pick->ref_error) || c->ref_error < pick->ref_error)))
-        pick = c;
-    }
+      }
+    if (!pick)
+      for (const CaseResult* c : p.cases)
+        if (!pick && c->entry->method == m && c->entry->overlay && has_series(dir, c)) pick = c;
     if (pick) out.push_back(pick);
   }
   return out;
@@ -495,6 +497,8 @@ nav a { margin-right: 14px; }
 details summary { cursor: pointer; font-weight: bold; margin: 8px 0; }
 pre { background: #f6f8fa; padding: 10px; font-size: 12px; overflow-x: auto; }
 .win { font-weight: bold; color: #006d3a; }
+div.wide { overflow-x: auto; max-width: 100%; }
+td.reason { max-width: 360px; font-size: 12px; color: #444; }
 )";
 
 }  // namespace
@@ -869,7 +873,7 @@ ReportResult build_report(const std::string& dir, const ReportOptions& opt, std:
   h << "<h2 id=\"cases\">All cases</h2>\n<p class=\"meta\">One row per case (repeats folded: wall time is their "
        "median). Every repeat is a row of <code>summary.csv</code>; the tidy work-precision table is "
        "<code>work_precision.csv</code>, the rankings <code>fastest.csv</code>.</p>\n";
-  h << "<table><tr><th>#</th><th>case_id</th><th>sweep</th><th>problem</th><th>method</th><th>formulation</th>"
+  h << "<div class=\"wide\"><table><tr><th>#</th><th>case_id</th><th>sweep</th><th>problem</th><th>method</th><th>formulation</th>"
        "<th>integrator</th><th>setting</th><th>t_end</th><th>status</th><th>wall (median)</th><th>repeats ok</th>"
        "<th>steps</th><th>ref error</th><th>digits</th><th>max residual</th><th>max drift</th><th>reason</th></tr>\n";
   std::map<std::string, std::pair<size_t, std::string>> not_applicable;  // "problem method integrator" -> count, reason
@@ -891,9 +895,10 @@ ReportResult build_report(const std::string& dir, const ReportOptions& opt, std:
       << "</td><td class=\"num\">" << c.ok_repeats << "/" << c.entry->repeats << "</td><td class=\"num\">"
       << html(c.steps) << "</td><td class=\"num\">" << sci(c.ref_error) << "</td><td class=\"num\">"
       << (std::isnan(c.ref_scd) ? "" : sci(c.ref_scd)) << "</td><td class=\"num\">" << sci(c.max_residual)
-      << "</td><td class=\"num\">" << sci(c.drift) << "</td><td>" << html(c.reason) << "</td></tr>\n";
+      << "</td><td class=\"num\">" << sci(c.drift) << "</td><td class=\"reason\">" << html(c.reason)
+      << "</td></tr>\n";
   }
-  h << "</table>\n";
+  h << "</table></div>\n";
   if (!not_applicable.empty()) {
     h << "<h3>Not applicable</h3>\n<p class=\"meta\">Combinations the harness rejected before running "
          "(status <code>invalid</code> in summary.csv).</p>\n<table><tr><th>problem / method / integrator</th>"

@@ -177,6 +177,17 @@ TEST(MatrixExpand, DefaultMatrixCoversEveryApplicableProblemMethodPair) {
       }
 }
 
+TEST(MatrixExpand, ShippedMatricesExpand) {
+  size_t files = 0;
+  for (const auto& f : fs::directory_iterator(CSTAB_SOURCE_DIR "/matrices")) {
+    if (f.path().extension() != ".toml") continue;
+    ++files;
+    const auto ex = expand_matrix(read_matrix_file(f.path().string()), registry_catalog());
+    EXPECT_FALSE(ex.cases.empty()) << f.path();
+  }
+  EXPECT_GE(files, 1u);
+}
+
 // ---------------------------------------------------------------------------
 // Runs of the binary.
 
