@@ -4,6 +4,7 @@
 #include "methods/dispatch.hpp"
 #include "problems/wheel.hpp"
 #include "problems/ball.hpp"
+#include "problems/biped.hpp"
 #include "problems/slider_crank.hpp"
 #include "problems/andrews.hpp"
 #include "problems/car_axis.hpp"
@@ -15,6 +16,7 @@ const std::vector<std::unique_ptr<Problem>>& all_problems() {
     std::vector<std::unique_ptr<Problem>> v;
     v.push_back(std::make_unique<ProblemAdapter<Wheel>>(Wheel{}));
     v.push_back(std::make_unique<ProblemAdapter<Ball>>(Ball{}));
+    v.push_back(std::make_unique<ProblemAdapter<Biped>>(Biped{}));
     v.push_back(std::make_unique<ProblemAdapter<SliderCrank>>(SliderCrank{}));
     v.push_back(std::make_unique<ProblemAdapter<Andrews>>(Andrews{}));
     v.push_back(std::make_unique<ProblemAdapter<CarAxis>>(CarAxis{}));
