@@ -150,7 +150,7 @@ int cmd_matrix(const std::vector<std::string>& argv) {
     return 0;
   }
   if (args.positional().size() > 1)
-    throw UsageError("matrix: one matrix file at most (got '" + args.positional()[1] + "' too)");
+    throw UsageError("one matrix file at most (got '" + args.positional()[1] + "' too)");
   const bool from_file = !args.positional().empty();
   const MatrixFile file = from_file ? read_matrix_file(args.positional()[0])
                                     : parse_matrix(default_matrix_text(), "<default matrix>");
@@ -228,7 +228,7 @@ int cmd_matrix(const std::vector<std::string>& argv) {
 int cmd_merge(const std::vector<std::string>& argv) {
   Args args(argv, {"--jobs"}, {"--no-report"});
   const auto& pos = args.positional();
-  if (pos.size() < 2) throw UsageError("merge: usage: cstab merge OUT SHARD_DIR... (at least one shard folder)");
+  if (pos.size() < 2) throw UsageError("usage: cstab merge OUT SHARD_DIR... (at least one shard folder)");
   const std::vector<std::string> shards(pos.begin() + 1, pos.end());
   const size_t missing = merge_results(pos[0], shards, std::cout);
   if (!args.has("--no-report")) finish(pos[0], jobs_flag(args), true);
@@ -241,7 +241,7 @@ int cmd_merge(const std::vector<std::string>& argv) {
 
 int cmd_report(const std::vector<std::string>& argv) {
   Args args(argv, {"--jobs"}, {"--no-plots"});
-  if (args.positional().size() != 1) throw UsageError("report: usage: cstab report DIR [--jobs N] [--no-plots]");
+  if (args.positional().size() != 1) throw UsageError("usage: cstab report DIR [--jobs N] [--no-plots]");
   const std::string dir = args.positional()[0];
   std::vector<CaseEntry> entries;
   try {

@@ -426,7 +426,7 @@ size_t write_matrix_summary(const std::string& dir, const std::vector<CaseEntry>
 }
 
 size_t merge_results(const std::string& out_dir, const std::vector<std::string>& shard_dirs, std::ostream& log) {
-  if (shard_dirs.empty()) throw UsageError("merge: give at least one shard folder");
+  if (shard_dirs.empty()) throw UsageError("give at least one shard folder");
   std::string matrix_text;
   std::map<size_t, std::pair<CaseEntry, std::string>> by_index;  // index -> entry, source folder
   size_t selected_cases = 0;
@@ -436,30 +436,30 @@ size_t merge_results(const std::string& out_dir, const std::vector<std::string>&
     const std::string& dir = shard_dirs[s];
     std::error_code same_ec;
     if (fs::equivalent(dir, out_dir, same_ec))
-      throw UsageError("merge: the output folder " + out_dir + " is also a shard folder");
+      throw UsageError("the output folder " + out_dir + " is also a shard folder");
     std::string text;
     try {
       text = read_text_file(dir + "/matrix.toml");
     } catch (const std::exception&) {
-      throw UsageError("merge: " + dir + " is not a matrix results folder (no matrix.toml)");
+      throw UsageError(dir + " is not a matrix results folder (no matrix.toml)");
     }
     if (s == 0)
       matrix_text = text;
     else if (text != matrix_text)
-      throw UsageError("merge: " + dir + " ran a different matrix than " + shard_dirs[0] +
+      throw UsageError(dir + " ran a different matrix than " + shard_dirs[0] +
                        " (matrix.toml differs)");
     size_t n = 0;
     std::vector<CaseEntry> entries;
     try {
       entries = read_manifest(dir + "/cases.csv", &n);
     } catch (const std::runtime_error& e) {
-      throw UsageError("merge: " + dir + ": " + e.what());
+      throw UsageError(dir + ": " + e.what());
     }
     if (n) selected_cases = n;
     for (auto& e : entries) {
       auto [it, inserted] = by_index.emplace(e.index, std::make_pair(e, dir));
       if (!inserted && it->second.first.id != e.id)
-        throw UsageError("merge: case " + std::to_string(e.index) + " differs between " + it->second.second +
+        throw UsageError("case " + std::to_string(e.index) + " differs between " + it->second.second +
                          " and " + dir);
     }
     try {
@@ -475,7 +475,7 @@ size_t merge_results(const std::string& out_dir, const std::vector<std::string>&
 
   std::error_code ec;
   fs::create_directories(out_dir + "/cases", ec);
-  if (ec) throw UsageError("merge: cannot create " + out_dir + ": " + ec.message());
+  if (ec) throw UsageError("cannot create " + out_dir + ": " + ec.message());
   std::vector<CaseEntry> entries;
   size_t copied = 0;
   for (const auto& [index, entry_source] : by_index) {
