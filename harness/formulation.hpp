@@ -24,6 +24,30 @@ class OdeSystem {
   std::string no_failure_;
 };
 
+// F(t, y, y') = 0 on raw arrays of `dae_dimension()` doubles, for an
+// implicit DAE solver (the "ida" integrator). A Formulation that is a DAE
+// derives from both Formulation and DaeSystem: its dimension() equals
+// dae_dimension() and its first entries are the mechanical state, so the
+// observables (residuals, to_canonical) read the same array; its rhs()
+// fails, saying it needs --integrator ida. The reason for a failed
+// residual() is OdeSystem::failure_reason().
+class DaeSystem {
+ public:
+  virtual ~DaeSystem() = default;
+  virtual int dae_dimension() const = 0;
+  // Initial guesses at t0: y as Formulation::initial_state, and y'. The
+  // solver makes them consistent (algebraic y and differential y' adjusted).
+  virtual void initial_values(double t0, double* y, double* yp) const = 0;
+  // Per component: 1 differential (y' appears), 0 algebraic.
+  virtual void component_ids(double* id) const = 0;
+  // Differentiation index. The solver's consistent-initial-value
+  // calculation (IDACalcIC) is for index 1; a higher-index DAE must return
+  // consistent initial_values itself (the solver checks F = 0 there).
+  virtual int index() const { return 1; }
+  // r = F(t, y, y'). Returns false if F cannot be evaluated at this point.
+  virtual bool residual(double t, const double* y, const double* yp, double* r) = 0;
+};
+
 struct ConstraintInfo {
   std::string name;  // used in column names: residual_<name>
   std::string kind;  // holonomic | non-holonomic | holonomic (time-dependent) | ...

@@ -21,6 +21,8 @@ const std::vector<IntegratorInfo>& all_integrators() {
       {"rkf45", "GSL Runge-Kutta-Fehlberg 4(5), adaptive", false, 5},
       {"msadams", "GSL variable-order Adams (orders 1-12), adaptive", false, 12},
       {"msbdf", "GSL variable-order BDF (orders 1-5), adaptive, implicit", false, 5},
+      {"ida", "SUNDIALS IDA variable-order BDF (orders 1-5) for DAEs F(t, y, y') = 0, adaptive; "
+              "needs a DAE method (ida-index1, ida-ggl)", false, 5, true},
   };
   return list;
 }
@@ -271,6 +273,8 @@ class GslAdaptive final : public Integrator {
 
 }  // namespace
 
+std::unique_ptr<Integrator> make_ida_integrator(const StepSettings& settings);  // ida_integrator.cpp
+
 std::unique_ptr<Integrator> make_integrator(const std::string& name, const StepSettings& s) {
   static const bool gsl_quiet = [] { gsl_set_error_handler_off(); return true; }();
   (void)gsl_quiet;
@@ -291,6 +295,7 @@ std::unique_ptr<Integrator> make_integrator(const std::string& name, const StepS
   if (name == "rkf45") return std::make_unique<GslAdaptive>(gsl_odeiv2_step_rkf45, s, false);
   if (name == "msadams") return std::make_unique<GslAdaptive>(gsl_odeiv2_step_msadams, s, false);
   if (name == "msbdf") return std::make_unique<GslAdaptive>(gsl_odeiv2_step_msbdf, s, true);
+  if (name == "ida") return make_ida_integrator(s);
   throw UsageError("--integrator " + name + ": not constructible");
 }
 

@@ -7,6 +7,7 @@
 
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "formulation.hpp"
@@ -18,6 +19,7 @@ struct IntegratorInfo {
   std::string description;
   bool fixed_step;  // needs --step; otherwise needs --rtol/--atol
   int order;        // classical order of accuracy
+  bool solves_dae = false;  // steps F(t, y, y') = 0 (a DaeSystem), not y' = f
 };
 
 const std::vector<IntegratorInfo>& all_integrators();
@@ -54,6 +56,8 @@ class Integrator {
   long rhs_evals() const { return rhs_evals_; }
   double last_step_size() const { return h_used_; }
   const std::string& failure_reason() const { return failure_; }
+  // Solver-specific counters (name, value), appended to the summary row.
+  virtual std::vector<std::pair<std::string, std::string>> statistics() const { return {}; }
 
  protected:
   // Counts and forwards to the system; records a failure reason.

@@ -183,6 +183,15 @@ RunResult run_case(const Problem& problem, const RunConfig& cfg, const std::stri
   const auto specs = problem.method_params(cfg.method, cfg.formulation);
   const Params params = Params::resolve(specs, cfg.params, cfg.method);
   auto form = problem.make(cfg.method, cfg.formulation, params);
+  // A DAE formulation (F(t, y, y') = 0) needs a DAE solver, and a DAE solver
+  // needs one.
+  const bool is_dae = dynamic_cast<const DaeSystem*>(form.get()) != nullptr;
+  if (is_dae && !integ_info.solves_dae)
+    throw UsageError("--integrator " + cfg.integrator + ": method '" + cfg.method +
+                     "' is a DAE formulation F(t, y, y') = 0 and needs a DAE integrator (--integrator ida)");
+  if (!is_dae && integ_info.solves_dae)
+    throw UsageError("--integrator " + cfg.integrator + ": solves DAEs F(t, y, y') = 0, but method '" +
+                     cfg.method + "' is an ODE formulation; use a DAE method (ida-index1, ida-ggl)");
   auto integrator = make_integrator(cfg.integrator, cfg.step);
   form->set_step_hint(integ_info.fixed_step ? cfg.step.step : 0.0);
 
@@ -293,6 +302,7 @@ RunResult run_case(const Problem& problem, const RunConfig& cfg, const std::stri
   result.steps = integrator->steps();
   result.rejected_steps = integrator->rejected_steps();
   result.rhs_evals = integrator->rhs_evals();
+  for (auto& kv : integrator->statistics()) result.extra.push_back(std::move(kv));
 
   // ---- write ----
   if (!out_dir.empty()) {

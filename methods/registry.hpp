@@ -4,6 +4,7 @@
 
 #include "methods/baumgarte.hpp"
 #include "methods/braun_goldfarb.hpp"
+#include "methods/ida.hpp"
 #include "methods/index1.hpp"
 #include "methods/minimal.hpp"
 #include "methods/pesterev.hpp"
@@ -14,6 +15,6 @@ template <class... Ms>
 struct TypeList {};
 
 using MethodList = TypeList<PesterevMethod, BaumgarteMethod, BraunGoldfarbMethod, ProjectionMethod, NoneMethod,
-                            MinimalMethod>;
+                            MinimalMethod, IdaIndexOneMethod, IdaGglMethod>;
 
 }  // namespace cstab

@@ -1,0 +1,235 @@
+// Mechanical models as DAEs F(t, y, y') = 0 for the "ida" integrator
+// (SUNDIALS IDA, BDF). Two classical formulations, both with the constraint
+// forces A^T lambda of the mechanical description (methods/mechanical.hpp):
+//
+//  ida-index1   y = [q; v; lambda]                  (2 nq + nc unknowns)
+//      q' - v                      = 0
+//      M v' - Q - A^T lambda       = 0
+//      A v' + gamma                = 0   acceleration-level constraints
+//    lambda algebraic. Index 1: nothing holds Phi = 0 or the velocity
+//    constraints, so they drift like the `none` ODE (at the tolerance).
+//
+//  ida-ggl      y = [q; v; lambda; mu]              (2 nq + nc + nh unknowns)
+//      q' - v - J^T mu             = 0   J = dPhi/dq (holonomic rows only)
+//      M v' - Q - A^T lambda       = 0
+//      [J v + Phi_t; Psi]          = 0   velocity-level constraints
+//      Phi                         = 0   position-level constraints
+//    lambda, mu algebraic. The stabilized index-2 formulation of
+//    Gear, Gupta and Leimkuhler (1985), as in the SUNDIALS example
+//    idasSlCrank_dns: mu = 0 on the exact solution and both constraint
+//    levels hold to the Newton tolerance. Index-2 variables cannot be
+//    error-controlled by BDF, so the integrator excludes algebraic
+//    components from the error test (IDASetSuppressAlg), as is standard.
+//
+// The first 2 nq entries of y are [q; v], so the shared observables
+// (residuals, to_canonical) read the same array. Both start from q(0), v(0)
+// projected onto the constraints when the problem's data violate them, and
+// both need full-rank constraint rows (the iteration matrix contains the
+// KKT matrix).
+#pragma once
+
+#include <cmath>
+
+#include "methods/mechanical_method.hpp"
+#include "methods/weighted_pinv.hpp"
+
+namespace cstab {
+
+template <class Model, bool kGgl>
+class MechanicalDaeFormulation final : public MechanicalFormulationBase<Model>, public DaeSystem {
+  using Base = MechanicalFormulationBase<Model>;
+
+ public:
+  using Base::nc;
+  using Base::nh;
+  using Base::nq;
+  using typename Base::VecQ;
+  static constexpr int nm = kGgl ? nh : 0;  // GGL multipliers of q' = v + J^T mu
+  static constexpr int kDim = 2 * nq + nc + nm;
+  static constexpr int kLambda = 2 * nq;    // offset of lambda in y
+  static constexpr int kMu = 2 * nq + nc;   // offset of mu in y
+  static constexpr int nk = nq + nc;        // KKT size (initial values)
+
+  MechanicalDaeFormulation(const Model& model, const char* method) : Base(model), method_(method) {}
+
+  int dimension() const override { return kDim; }
+  int dae_dimension() const override { return kDim; }
+
+  bool rhs(double, const double*, double*) override {
+    this->failure_ = std::string(method_) + " is a DAE formulation: it needs --integrator ida";
+    return false;
+  }
+
+  void initial_state(double* y) const override {
+    Vec<double, kDim> yp;
+    initial_values(0.0, y, yp.data());
+  }
+
+  // q, v from the model (made consistent, see consistent_state); a and
+  // lambda from the KKT system (the acceleration level, exact for consistent
+  // q, v); mu = 0, lambda' = mu' = 0.
+  void initial_values(double t0, double* y, double* yp) const override {
+    VecQ q, v;
+    consistent_state(t0, q, v);
+    MechanicalTerms<Model> terms;
+    terms.evaluate(this->model_, t0, q, v, false);
+    Eigen::Matrix<double, nk, nk> K = Eigen::Matrix<double, nk, nk>::Zero();
+    Vec<double, nk> b;
+    K.template topLeftCorner<nq, nq>() = terms.M;
+    b.template head<nq>() = terms.Q;
+    if constexpr (nc > 0) {
+      K.template topRightCorner<nq, nc>() = -terms.A.transpose();
+      K.template bottomLeftCorner<nc, nq>() = terms.A;
+      b.template tail<nc>() = -terms.gamma;
+    }
+    const Eigen::PartialPivLU<Eigen::Matrix<double, nk, nk>> lu(K);
+    Vec<double, nk> x = lu.solve(b);
+    if (!(lu.rcond() > 1e-15) || !x.allFinite()) {
+      // Leave the multipliers to IDACalcIC.
+      x.setZero();
+      x.template head<nq>() = terms.M.ldlt().solve(terms.Q);
+    }
+    for (int i = 0; i < kDim; ++i) y[i] = yp[i] = 0;
+    vmap<nq>(y) = q;
+    vmap<nq>(y + nq) = v;
+    vmap<nq>(yp) = v;
+    vmap<nq>(yp + nq) = x.template head<nq>();
+    if constexpr (nc > 0) vmap<nc>(y + kLambda) = x.template tail<nc>();
+  }
+
+  // The problem's q(0), v(0), moved onto the constraints if they violate
+  // them (some problems' published initial data do): GGL has no solution
+  // through an inconsistent point, IDACalcIC never changes differential
+  // components, and index 1 would carry the violation along unchanged.
+  // Positions follow the correction flow
+  //     dq/dtau = -M^-1 J^T (J M^-1 J^T)^-1 Phi(t0, q)   (Phi decays like e^-tau)
+  // to its end point, the limit every stabilization's transient tends to
+  // (RK4 in tau, then Gauss-Newton to polish; a single Gauss-Newton
+  // projection lands elsewhere on the manifold, by 1.8e-5 on the biped's
+  // 4.9e-3 m inconsistency). Velocities then take the least change in the
+  // mass norm (affine constraints: one correction). Consistent data are left
+  // untouched.
+  void consistent_state(double t0, VecQ& q, VecQ& v) const {
+    this->model_.initial_state(q, v);
+    if constexpr (nc > 0) {
+      constexpr double kTol = 1e-14;
+      MechanicalTerms<Model> terms;
+      Eigen::Matrix<double, nq, nq> M;
+      if constexpr (nh > 0) {
+        WeightedPinv<nh, nq> pinv;
+        // -dq/dtau at q; false if M is singular.
+        auto flow = [&](const VecQ& at, VecQ& direction) {
+          terms.evaluate_position(this->model_, t0, at);
+          this->model_.mass(t0, at, M);
+          if (!pinv.factor_mass(M)) return false;
+          pinv.set_rows(terms.A.template topRows<nh>());
+          direction = pinv.correction(terms.phi);
+          return true;
+        };
+        terms.evaluate_position(this->model_, t0, q);
+        if (terms.phi.template lpNorm<Eigen::Infinity>() > kTol) {
+          constexpr double kDtau = 0.25, kTauEnd = 30;  // e^-30 ~ 1e-13
+          VecQ k1, k2, k3, k4;
+          for (double tau = 0; tau < kTauEnd; tau += kDtau) {
+            if (!flow(q, k1) || !flow(q - 0.5 * kDtau * k1, k2) || !flow(q - 0.5 * kDtau * k2, k3) ||
+                !flow(q - kDtau * k3, k4))
+              break;
+            q -= kDtau / 6 * (k1 + 2 * k2 + 2 * k3 + k4);
+          }
+          for (int it = 0; it < 5; ++it) {
+            terms.evaluate_position(this->model_, t0, q);
+            if (terms.phi.template lpNorm<Eigen::Infinity>() <= kTol) break;
+            VecQ step;
+            if (!flow(q, step)) break;
+            q -= step;
+          }
+        }
+      }
+      terms.evaluate_velocity(this->model_, t0, q, v);
+      if (terms.velocity.template lpNorm<Eigen::Infinity>() > kTol) {
+        this->model_.mass(t0, q, M);
+        WeightedPinv<nc, nq> velocity_pinv;
+        if (velocity_pinv.factor_mass(M)) {
+          velocity_pinv.set_rows(terms.A);
+          v -= velocity_pinv.correction(terms.velocity);
+        }
+      }
+    }
+  }
+
+  // GGL is index 2: the integrator checks its initial values instead of
+  // calling IDACalcIC (index 1 only).
+  int index() const override { return kGgl ? 2 : 1; }
+
+  void component_ids(double* id) const override {
+    for (int i = 0; i < kDim; ++i) id[i] = i < 2 * nq ? 1.0 : 0.0;
+  }
+
+  bool residual(double t, const double* y, const double* yp, double* r) override {
+    const VecQ q = vmap<nq>(y), v = vmap<nq>(y + nq);
+    const auto qp = vmap<nq>(yp);
+    const auto vp = vmap<nq>(yp + nq);
+    if constexpr (kGgl) {
+      // Velocity and position levels only: no acceleration-level terms.
+      this->model_.mass(t, q, terms_.M);
+      this->model_.forces(t, q, v, terms_.Q);
+      terms_.evaluate_velocity(this->model_, t, q, v);
+    } else {
+      terms_.evaluate(this->model_, t, q, v, false);
+    }
+    auto r_q = vmap<nq>(r);
+    auto r_v = vmap<nq>(r + nq);
+    r_q = qp - v;
+    r_v = terms_.M * vp - terms_.Q;
+    if constexpr (nc > 0) {
+      r_v -= terms_.A.transpose() * vmap<nc>(y + kLambda);
+      if constexpr (kGgl)
+        vmap<nc>(r + kLambda) = terms_.velocity;
+      else
+        vmap<nc>(r + kLambda) = terms_.A * vp + terms_.gamma;
+    }
+    if constexpr (nm > 0) {
+      r_q -= terms_.A.template topRows<nh>().transpose() * vmap<nm>(y + kMu);
+      vmap<nm>(r + kMu) = terms_.phi;
+    }
+    for (int i = 0; i < kDim; ++i) {
+      if (!std::isfinite(r[i])) {
+        this->failure_ = std::string(method_) + ": non-finite residual at t = " + std::to_string(t);
+        return false;
+      }
+    }
+    return true;
+  }
+
+ private:
+  const char* method_;
+  MechanicalTerms<Model> terms_;
+};
+
+struct IdaIndexOneMethod : MechanicalMethod<IdaIndexOneMethod> {
+  static constexpr const char* kName = "ida-index1";
+  static constexpr const char* kDescription =
+      "DAE for --integrator ida: [q, v, lambda], constraints at acceleration level (index 1); drifts at "
+      "the tolerance (full rank)";
+  static std::vector<ParamSpec> generic_params() { return {}; }
+  template <class Model>
+  static std::unique_ptr<Formulation> make_model(const Model& model, const Params&) {
+    require_full_rank(model, kName);
+    return std::make_unique<MechanicalDaeFormulation<Model, false>>(model, kName);
+  }
+};
+
+struct IdaGglMethod : MechanicalMethod<IdaGglMethod> {
+  static constexpr const char* kName = "ida-ggl";
+  static constexpr const char* kDescription =
+      "DAE for --integrator ida: stabilized index-2 Gear-Gupta-Leimkuhler [q, v, lambda, mu], position and "
+      "velocity constraints enforced (full rank)";
+  static std::vector<ParamSpec> generic_params() { return {}; }
+  template <class Model>
+  static std::unique_ptr<Formulation> make_model(const Model& model, const Params&) {
+    require_full_rank(model, kName);
+    return std::make_unique<MechanicalDaeFormulation<Model, true>>(model, kName);
+  }
+};
+
+}  // namespace cstab
