@@ -4,6 +4,7 @@
 #include <sstream>
 
 #include "cli/args.hpp"
+#include "cli/stability_command.hpp"
 #include "cli/matrix_commands.hpp"
 #include "harness/format.hpp"
 #include "harness/integrator.hpp"
@@ -22,6 +23,8 @@ usage:
             --integrator I (--step H | --rtol R --atol A) --t-end T
             [--times t1,t2,...] [--sample-every DT] [--ref-time T]
             [--blowup B] [--observe-every N] --out DIR
+  cstab stability --problem P --method M --integrator I --gain-param NAME
+            --steps h1,h2,... --gains g1,g2,... --t-end T --out DIR [--param k=v ...]
   cstab matrix [FILE] --out DIR [--jobs N] [--shard k/N] [--filter S] [--force]
                [--no-report] [--list] [--print-default]
                runs a benchmark matrix (default: the embedded one; docs/matrix.md)
@@ -139,6 +142,7 @@ int cmd_run(const std::vector<std::string>& argv) {
 int dispatch(const std::string& command, const std::vector<std::string>& args) {
   if (command == "list") return cmd_list(args);
   if (command == "run") return cmd_run(args);
+  if (command == "stability") return cmd_stability(args);
   if (command == "matrix") return cmd_matrix(args);
   if (command == "merge") return cmd_merge(args);
   if (command == "report") return cmd_report(args);

@@ -53,6 +53,11 @@ class Problem {
   // Empty if `method` applies; otherwise the reason it does not.
   virtual std::string why_not(const std::string& method) const = 0;
 
+  // The bare dynamics with every constraint ignored (M^-1 Q for a mechanical
+  // model, the drift F for an affine one): the cost baseline of benchmarks.
+  // nullptr if the problem has neither.
+  virtual std::unique_ptr<Formulation> make_unconstrained() const { return nullptr; }
+
   // Energy of a canonical state (only if info().has_energy).
   virtual double energy(double /*t*/, const double* /*canonical*/) const { return 0; }
   // First integrals other than energy, in info().first_integrals order.

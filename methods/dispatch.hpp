@@ -9,6 +9,7 @@
 
 #include "harness/problem.hpp"
 #include "methods/registry.hpp"
+#include "methods/unconstrained.hpp"
 
 namespace cstab {
 
@@ -70,6 +71,16 @@ class ProblemAdapter final : public Problem {
       if (method == M::kName) f = M::make(p_, formulation, params);
     });
     return f;
+  }
+
+  std::unique_ptr<Formulation> make_unconstrained() const override {
+    if constexpr (HasMechanical<P>) {
+      return std::make_unique<UnconstrainedMechanical<std::decay_t<decltype(p_.mechanical())>>>(p_.mechanical());
+    } else if constexpr (requires { p_.state_space(); }) {
+      return std::make_unique<UnconstrainedAffine<std::decay_t<decltype(p_.state_space())>>>(p_.state_space());
+    } else {
+      return nullptr;
+    }
   }
 
   double energy(double t, const double* c) const override {

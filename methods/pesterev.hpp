@@ -13,7 +13,7 @@
 #include "harness/formulation.hpp"
 #include "harness/params.hpp"
 #include "methods/affine.hpp"
-#include "methods/mechanical_affine.hpp"
+#include "methods/mechanical.hpp"
 
 namespace cstab {
 
@@ -105,6 +105,89 @@ class PesterevFormulation final : public Formulation {
   std::string failure_;
 };
 
+// Lambda-feedback on a mechanical model, written directly in its terms. With
+// X = [q; v], F = [v; a], a = M^-1 Q, B = [0; M^-1 A^T] (MechanicalAsAffine),
+// the Lie derivatives are L_F Phi = J v + Phi_t, L_F^2 Phi = J a + gamma_h,
+// L_F Psi = G a + gamma_n and L_B L_F^{r-1} f = A M^-1 A^T, so eq. (9) reads
+//   (A M^-1 A^T) N = -(A a + gamma + [2 lambda Phi' + lambda^2 Phi; lambda Psi]).
+// This fast path avoids nesting AD through M^-1 Q; a test checks it against
+// the generic LieJet on MechanicalAsAffine.
+template <class Model>
+class PesterevMechanicalFormulation final : public MechanicalFormulationBase<Model> {
+  using Base = MechanicalFormulationBase<Model>;
+
+ public:
+  using Base::nc;
+  using Base::nh;
+  using Base::nq;
+  using typename Base::VecQ;
+
+  PesterevMechanicalFormulation(const Model& model, const Params& params) : Base(model) {
+    const double lambda = params.get("lambda");
+    for (int i = 0; i < nc; ++i) {
+      const std::string key = "lambda_" + this->constraints_[i].name;
+      lambda_(i) = params.given(key) ? params.get(key) : lambda;
+    }
+    VecQ q, v;
+    model.initial_state(q, v);
+    build(0.0, q, v);
+    lu_.compute(Amat_);
+    if (!(lu_.rcond() > 1e-12))
+      throw UsageError("pesterev: A(X0) = A M^-1 A^T is singular at the initial state (rcond " +
+                       std::to_string(lu_.rcond()) + "): redundant constraints; use braun-goldfarb or projection");
+  }
+
+  bool rhs(double t, const double* y, double* dydt) override {
+    const VecQ q = vmap<nq>(y), v = vmap<nq>(y + nq);
+    if (!build(t, q, v)) return false;
+    Vec<double, nc> phi = terms_.A * a_ + terms_.gamma;
+    for (int i = 0; i < nc; ++i) {
+      const double l = lambda_(i);
+      phi(i) += i < nh ? 2 * l * terms_.velocity(i) + l * l * terms_.phi(i) : l * terms_.velocity(i);
+    }
+    lu_.compute(Amat_);
+    const double rcond = lu_.rcond();
+    if (!(rcond > 1e-14)) {
+      this->failure_ = "reaction matrix A(X) singular (rcond " + std::to_string(rcond) + ") at t = " + std::to_string(t);
+      return false;
+    }
+    const Vec<double, nc> N = lu_.solve(-phi);
+    vmap<nq>(dydt) = v;
+    vmap<nq>(dydt + nq) = a_ + W_ * N;
+    return true;
+  }
+
+  bool has_condition_number() const override { return true; }
+  double condition_number(double t, const double* y) override {
+    if (!build(t, vmap<nq>(y).eval(), vmap<nq>(y + nq).eval())) return NAN;
+    Eigen::JacobiSVD<Eigen::Matrix<double, nc, nc>> svd(Amat_);
+    const auto& s = svd.singularValues();
+    return s(nc - 1) > 0 ? s(0) / s(nc - 1) : std::numeric_limits<double>::infinity();
+  }
+
+ private:
+  bool build(double t, const VecQ& q, const VecQ& v) {
+    terms_.evaluate(this->model_, t, q, v, false);
+    llt_.compute(terms_.M);
+    if (llt_.info() != Eigen::Success) {
+      this->failure_ = "mass matrix not positive definite at t = " + std::to_string(t);
+      return false;
+    }
+    a_ = llt_.solve(terms_.Q);
+    W_ = llt_.solve(terms_.A.transpose());
+    Amat_ = terms_.A * W_;
+    return true;
+  }
+
+  Vec<double, nc> lambda_;
+  MechanicalTerms<Model> terms_;
+  Eigen::LLT<Eigen::Matrix<double, nq, nq>> llt_;
+  VecQ a_;
+  Eigen::Matrix<double, nq, nc> W_;
+  Eigen::Matrix<double, nc, nc> Amat_;
+  Eigen::PartialPivLU<Eigen::Matrix<double, nc, nc>> lu_;
+};
+
 // Registry entry: applies to any problem with an affine (state-space) model,
 // and to any mechanical model through MechanicalAsAffine.
 struct PesterevMethod {
@@ -144,8 +227,8 @@ struct PesterevMethod {
     }
     if constexpr (HasMechanical<P>) {
       if (formulation.empty() || formulation == p.mechanical().formulation_name()) {
-        using Model = MechanicalAsAffine<std::decay_t<decltype(p.mechanical())>>;
-        return std::make_unique<PesterevFormulation<Model>>(Model(p.mechanical()), params);
+        using Model = std::decay_t<decltype(p.mechanical())>;
+        return std::make_unique<PesterevMechanicalFormulation<Model>>(p.mechanical(), params);
       }
     }
     throw UsageError("--formulation " + formulation + ": pesterev cannot run on it");

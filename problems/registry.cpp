@@ -1,25 +1,27 @@
-// Adding a problem: a class in problems/ and one line in all_problems().
+// Adding a problem: a class in problems/, a register_<name>.cpp beside it
+// (one line: its ProblemAdapter), and one line in each list below.
 #include "problems/registry.hpp"
 
 #include "methods/dispatch.hpp"
-#include "problems/wheel.hpp"
-#include "problems/ball.hpp"
-#include "problems/biped.hpp"
-#include "problems/slider_crank.hpp"
-#include "problems/andrews.hpp"
-#include "problems/car_axis.hpp"
 
 namespace cstab {
+
+std::unique_ptr<Problem> make_wheel_problem();
+std::unique_ptr<Problem> make_ball_problem();
+std::unique_ptr<Problem> make_biped_problem();
+std::unique_ptr<Problem> make_slider_crank_problem();
+std::unique_ptr<Problem> make_andrews_problem();
+std::unique_ptr<Problem> make_car_axis_problem();
 
 const std::vector<std::unique_ptr<Problem>>& all_problems() {
   static const std::vector<std::unique_ptr<Problem>> list = [] {
     std::vector<std::unique_ptr<Problem>> v;
-    v.push_back(std::make_unique<ProblemAdapter<Wheel>>(Wheel{}));
-    v.push_back(std::make_unique<ProblemAdapter<Ball>>(Ball{}));
-    v.push_back(std::make_unique<ProblemAdapter<Biped>>(Biped{}));
-    v.push_back(std::make_unique<ProblemAdapter<SliderCrank>>(SliderCrank{}));
-    v.push_back(std::make_unique<ProblemAdapter<Andrews>>(Andrews{}));
-    v.push_back(std::make_unique<ProblemAdapter<CarAxis>>(CarAxis{}));
+    v.push_back(make_wheel_problem());
+    v.push_back(make_ball_problem());
+    v.push_back(make_biped_problem());
+    v.push_back(make_slider_crank_problem());
+    v.push_back(make_andrews_problem());
+    v.push_back(make_car_axis_problem());
     return v;
   }();
   return list;
