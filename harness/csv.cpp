@@ -45,16 +45,22 @@ std::string csv_field(const std::string& s) {
   return out + "\"";
 }
 
+std::string key_value_csv(const std::vector<std::pair<std::string, std::string>>& row) {
+  std::string header, values;
+  for (size_t i = 0; i < row.size(); ++i) {
+    if (i) {
+      header += ',';
+      values += ',';
+    }
+    header += csv_field(row[i].first);
+    values += csv_field(row[i].second);
+  }
+  return header + "\n" + values + "\n";
+}
+
 void write_key_value_csv(const std::string& path,
                          const std::vector<std::pair<std::string, std::string>>& row) {
-  std::string header, values;
-  for (const auto& [k, v] : row) {
-    header += (header.empty() ? "" : ",") + csv_field(k);
-    values += (values.empty() && &k == &row.front().first ? "" : ",") + csv_field(v);
-  }
-  AtomicFile f(path);
-  f.write(header + "\n" + values + "\n");
-  f.commit();
+  write_file_atomic(path, key_value_csv(row));
 }
 
 void write_file_atomic(const std::string& path, const std::string& content) {

@@ -31,6 +31,9 @@ class AtomicFile {
 // Quote a CSV field if it needs it (RFC 4180).
 std::string csv_field(const std::string& s);
 
+// Header line + data row text from ordered (column, value) pairs.
+std::string key_value_csv(const std::vector<std::pair<std::string, std::string>>& row);
+
 // One header line and one data row from ordered (column, value) pairs.
 void write_key_value_csv(const std::string& path,
                          const std::vector<std::pair<std::string, std::string>>& row);

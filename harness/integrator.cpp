@@ -64,8 +64,9 @@ class FixedStep : public Integrator {
   }
 
   StepOutcome step(double t_limit) override {
-    const double t_next = t0_ + double(grid_index_ + 1) * h_;
+    double t_next = t0_ + double(grid_index_ + 1) * h_;
     if (t_next > t_limit + 1e-9 * h_) return StepOutcome::kPastLimit;
+    if (std::abs(t_next - t_limit) <= 1e-9 * h_) t_next = t_limit;  // land exactly on output times
     if (!advance(t_next)) return StepOutcome::kFailed;
     ++grid_index_;
     ++steps_;

@@ -36,7 +36,7 @@ class PesterevFormulation final : public Formulation {
     const double lambda = params.get("lambda");
     for (int i = 0; i < m; ++i) {
       const std::string key = "lambda_" + constraints_[i].name;
-      const double li = params.given(key) ? params.get(key) : lambda;
+      const double li = params.get(key) > 0 ? params.get(key) : lambda;
       const int r = Model::kRelativeDegree[i];
       // gains_(i, k) multiplies L_F^k f_i.
       for (int k = 0; k < LieJet<Model>::kMaxDegree; ++k)
@@ -126,7 +126,7 @@ class PesterevMechanicalFormulation final : public MechanicalFormulationBase<Mod
     const double lambda = params.get("lambda");
     for (int i = 0; i < nc; ++i) {
       const std::string key = "lambda_" + this->constraints_[i].name;
-      lambda_(i) = params.given(key) ? params.get(key) : lambda;
+      lambda_(i) = params.get(key) > 0 ? params.get(key) : lambda;
     }
     VecQ q, v;
     model.initial_state(q, v);
@@ -212,8 +212,8 @@ struct PesterevMethod {
   static std::vector<ParamSpec> params(const P& p, const std::string& formulation) {
     auto specs = generic_params();
     for (const auto& c : constraints_of(p, formulation))
-      specs.push_back({"lambda_" + c.name, specs[0].default_value, Bound::kPositive,
-                       "lambda for output '" + c.name + "' (default: lambda)"});
+      specs.push_back({"lambda_" + c.name, 0, Bound::kNonNegative,
+                       "lambda for output '" + c.name + "' (0 = use lambda)"});
     return specs;
   }
 
