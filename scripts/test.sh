@@ -3,7 +3,7 @@
 # Extra arguments go to ctest (e.g. -L unit, -LE slow).
 set -euo pipefail
 cd "$(dirname "$0")/.."
-bash scripts/install-deps.sh
+bash scripts/install-deps.sh chromium  # chromium: the report is checked in a real browser
 bash scripts/build.sh
 cd build/release
 ctest --output-on-failure -j"$(nproc)" "$@"
