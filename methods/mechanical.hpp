@@ -103,15 +103,9 @@ struct MechanicalTerms {
     if constexpr (Model::kHasEnergy) {
       if (with_energy) {
         // Directions: the nq velocities, then the line (t + s, q + s v).
-        using D = ad::Dual<nq + 1>;
-        Vec<D, nq> qd, vd;
-        for (int i = 0; i < nq; ++i) {
-          Eigen::Matrix<double, nq + 1, 1> dq = Eigen::Matrix<double, nq + 1, 1>::Zero();
-          dq(nq) = v(i);
-          qd(i) = D(q(i), dq);
-          vd(i) = D(v(i), nq + 1, i);
-        }
-        const D td(t, nq + 1, nq);
+        LineDuals d(t, q, v);
+        const auto& [td, qd, vd] = d;
+        using D = LineDual;
         const D e = model.energy(td, qd, vd);
         energy = e.value();
         energy_grad_v = e.derivatives().template head<nq>();
@@ -121,16 +115,27 @@ struct MechanicalTerms {
   }
 
  private:
-  void nonholonomic_terms(const Model& model, double t, const VecQ& q, const VecQ& v) {
-    using D = ad::Dual<nq + 1>;
-    Vec<D, nq> qd, vd;
-    for (int i = 0; i < nq; ++i) {
-      Eigen::Matrix<double, nq + 1, 1> dq = Eigen::Matrix<double, nq + 1, 1>::Zero();
-      dq(nq) = v(i);
-      qd(i) = D(q(i), dq);
-      vd(i) = D(v(i), nq + 1, i);
+  // (t, q, v) as duals with nq + 1 directions: the nq velocities, then the
+  // line (t + s, q + s v) with v frozen. A function f(t, q, v) evaluated on
+  // them gives df/dv and df/dq v + df/dt (the part of df/dt not through a).
+  using LineDual = ad::Dual<nq + 1>;
+  struct LineDuals {
+    LineDual t;
+    Vec<LineDual, nq> q, v;
+    LineDuals(double t0, const VecQ& q0, const VecQ& v0) : t(t0, nq + 1, nq) {
+      for (int i = 0; i < nq; ++i) {
+        Eigen::Matrix<double, nq + 1, 1> dq = Eigen::Matrix<double, nq + 1, 1>::Zero();
+        dq(nq) = v0(i);
+        q(i) = LineDual(q0(i), dq);
+        v(i) = LineDual(v0(i), nq + 1, i);
+      }
     }
-    const D td(t, nq + 1, nq);
+  };
+
+  void nonholonomic_terms(const Model& model, double t, const VecQ& q, const VecQ& v) {
+    LineDuals d(t, q, v);
+    const auto& [td, qd, vd] = d;
+    using D = LineDual;
     Vec<D, nn> psi;
     model.nonholonomic(td, qd, vd, psi);
     for (int i = 0; i < nn; ++i) {
