@@ -243,13 +243,7 @@ int cmd_report(const std::vector<std::string>& argv) {
   Args args(argv, {"--jobs"}, {"--no-plots"});
   if (args.positional().size() != 1) throw UsageError("usage: cstab report DIR [--jobs N] [--no-plots]");
   const std::string dir = args.positional()[0];
-  std::vector<CaseEntry> entries;
-  try {
-    entries = read_manifest(dir + "/cases.csv");
-  } catch (const std::runtime_error& e) {
-    throw UsageError(dir + ": not a matrix results folder (" + e.what() + ")");
-  }
-  std::sort(entries.begin(), entries.end(), [](const CaseEntry& a, const CaseEntry& b) { return a.index < b.index; });
+  const std::vector<CaseEntry> entries = read_results_manifest(dir);
   write_matrix_summary(dir, entries);
   finish(dir, jobs_flag(args), !args.has("--no-plots"));
   return 0;

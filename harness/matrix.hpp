@@ -169,6 +169,9 @@ MatrixRunStats run_matrix(const std::vector<MatrixCase>& cases, const MatrixRunO
 // `selected_cases`: how many cases the run was given before sharding.
 void write_manifest(const std::string& path, const std::vector<CaseEntry>& entries, size_t selected_cases);
 std::vector<CaseEntry> read_manifest(const std::string& path, size_t* selected_cases = nullptr);
+// DIR/cases.csv of a results folder in expansion order; UsageError naming
+// DIR if it is not a matrix results folder.
+std::vector<CaseEntry> read_results_manifest(const std::string& dir);
 
 // DIR/summary.csv: every case's summary rows (one per repeat) in expansion
 // order, columns case_id, repeat, sweep, then the union of all cases'

@@ -365,6 +365,17 @@ void write_manifest(const std::string& path, const std::vector<CaseEntry>& entri
     write_file_atomic(path, rows_to_csv(rows));
 }
 
+std::vector<CaseEntry> read_results_manifest(const std::string& dir) {
+  std::vector<CaseEntry> entries;
+  try {
+    entries = read_manifest(dir + "/cases.csv");
+  } catch (const std::runtime_error& e) {
+    throw UsageError(dir + ": not a matrix results folder (" + e.what() + ")");
+  }
+  std::sort(entries.begin(), entries.end(), [](const CaseEntry& a, const CaseEntry& b) { return a.index < b.index; });
+  return entries;
+}
+
 std::vector<CaseEntry> read_manifest(const std::string& path, size_t* selected_cases) {
   const CsvTable t = read_csv(path);
   for (const char* col : {"index", "case_id", "problem", "method", "integrator", "curve"})

@@ -355,19 +355,23 @@ double cell(const std::vector<std::string>& row, int col) {
   return size_t(col) < row.size() ? to_number(row[col]) : kNaN;
 }
 
+// A case's series.csv; empty if it is missing or unreadable.
+CsvTable read_series(const std::string& dir, const CaseResult& c) {
+  try {
+    return read_csv(dir + "/cases/" + c.entry->id + "/series.csv");
+  } catch (const std::exception&) {
+    return {};
+  }
+}
+
 // Overlay data: per run, t, max |residual|, |drift|. Colours in `lcs`.
 std::string overlay_data(const std::string& dir, const std::vector<const CaseResult*>& runs,
                          const std::map<std::string, int>& colour, std::string& lcs, bool& has_drift) {
   std::string out;
   has_drift = false;
   for (const CaseResult* c : runs) {
-    CsvTable s;
-    try {
-      s = read_csv(dir + "/cases/" + c->entry->id + "/series.csv");
-    } catch (const std::exception&) {
-      continue;
-    }
-    if (s.rows.empty()) continue;
+    const CsvTable s = read_series(dir, *c);
+    if (s.rows.empty()) continue;  // missing or unreadable: the run is left out
     const SeriesColumns cols = classify(s);
     has_drift = has_drift || !cols.drifts.empty();
     if (!out.empty()) out += "\n\n";
@@ -390,13 +394,8 @@ std::string trajectory_data(const std::string& dir, const std::vector<const Case
                             std::vector<std::string>& names) {
   std::string out;
   for (const CaseResult* c : runs) {
-    CsvTable s;
-    try {
-      s = read_csv(dir + "/cases/" + c->entry->id + "/series.csv");
-    } catch (const std::exception&) {
-      continue;
-    }
-    if (s.rows.empty()) continue;
+    const CsvTable s = read_series(dir, *c);
+    if (s.rows.empty()) continue;  // missing or unreadable: the run is left out
     const SeriesColumns cols = classify(s);
     std::vector<int> shown;
     for (int col : cols.coords) {
@@ -523,13 +522,7 @@ std::string find_plot_scripts() {
 
 ReportResult build_report(const std::string& dir, const ReportOptions& opt, std::ostream& log) {
   ReportResult result;
-  std::vector<CaseEntry> entries;
-  try {
-    entries = read_manifest(dir + "/cases.csv");
-  } catch (const std::runtime_error& e) {
-    throw UsageError(dir + ": not a matrix results folder (" + e.what() + ")");
-  }
-  std::sort(entries.begin(), entries.end(), [](const CaseEntry& a, const CaseEntry& b) { return a.index < b.index; });
+  const std::vector<CaseEntry> entries = read_results_manifest(dir);
   CsvTable summary;
   try {
     summary = read_csv(dir + "/summary.csv");

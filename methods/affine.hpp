@@ -18,8 +18,12 @@
 
 #include <algorithm>
 #include <array>
+#include <limits>
+#include <string>
+#include <vector>
 
 #include "harness/autodiff.hpp"
+#include "harness/formulation.hpp"
 
 namespace cstab {
 
@@ -95,5 +99,46 @@ class LieJet {
     }
   }
 };
+
+// Shared parts of every formulation whose state is an affine model's X.
+template <class Model>
+class AffineFormulationBase : public Formulation {
+ public:
+  static constexpr int n = Model::kStates;
+  static constexpr int m = Model::kInputs;
+
+  explicit AffineFormulationBase(const Model& model) : model_(model), constraints_(model.constraints()) {}
+
+  std::string formulation_name() const override { return model_.formulation_name(); }
+  int dimension() const override { return n; }
+  void initial_state(double* y) const override {
+    Vec<double, n> X;
+    model_.initial_state(X);
+    vmap<n>(y) = X;
+  }
+  const std::vector<ConstraintInfo>& constraints() const override { return constraints_; }
+  void residuals(double t, const double* y, double* out) const override {
+    Vec<double, m> f;
+    model_.outputs(t, vmap<n>(y).eval(), f);
+    vmap<m>(out) = f;
+  }
+  void to_canonical(double t, const double* y, double* c) const override {
+    model_.to_canonical(t, vmap<n>(y).eval(), c);
+  }
+  const std::string& failure_reason() const override { return failure_; }
+
+ protected:
+  Model model_;
+  std::vector<ConstraintInfo> constraints_;
+  std::string failure_;
+};
+
+// 2-norm condition number of a small square matrix (infinite if singular).
+template <int K>
+double condition_number_of(const Eigen::Matrix<double, K, K>& A) {
+  Eigen::JacobiSVD<Eigen::Matrix<double, K, K>> svd(A);
+  const auto& s = svd.singularValues();
+  return s(K - 1) > 0 ? s(0) / s(K - 1) : std::numeric_limits<double>::infinity();
+}
 
 }  // namespace cstab

@@ -51,27 +51,27 @@ class BraunGoldfarbFormulation final : public MechanicalFormulationBase<Model> {
   bool rhs(double t, const double* y, double* dydt) override {
     const VecQ q = vmap<nq>(y), v = vmap<nq>(y + nq);
     terms_.evaluate(this->model_, t, q, v, energy_);
-    if (!pinv_v_.factor_mass(terms_.M)) {
+    if (!mass_.factor(terms_.M)) {
       this->failure_ = "mass matrix not positive definite at t = " + std::to_string(t);
       return false;
     }
     const double inv_dt = 1.0 / dt_;
-    const VecQ a = pinv_v_.mass_solve(terms_.Q);
+    const VecQ a = mass_.solve(terms_.Q);
     VecQ qdot = v;
     VecQ vdot = a;
     if constexpr (nh > 0) {
-      pinv_q_.factor_mass(terms_.M);
-      pinv_q_.set_rows(terms_.A.template topRows<nh>());
+      pinv_q_.set_rows(mass_, terms_.A.template topRows<nh>());
       qdot -= pinv_q_.correction(terms_.velocity.template head<nh>() + inv_dt * terms_.phi);
     }
+    // C_v^+ (b_v - A_v a - (Phi_q'; Phi_v)/dt), used by both corrections.
+    VecQ w = VecQ::Zero();
     if constexpr (nc > 0) {
-      pinv_v_.set_rows(terms_.A);
-      // b_v - A_v a - vel/dt
-      const Vec<double, nc> rv = -terms_.gamma - terms_.A * a - inv_dt * terms_.velocity;
-      vdot += pinv_v_.correction(rv);
+      pinv_v_.set_rows(mass_, terms_.A);
+      w = pinv_v_.pinv(-terms_.gamma - terms_.A * a - inv_dt * terms_.velocity);
+      vdot += mass_.r_inverse(w);
     }
     if constexpr (Model::kHasEnergy) {
-      if (energy_) vdot += energy_correction(a, inv_dt);
+      if (energy_) vdot += energy_correction(a, w, inv_dt);
     }
     vmap<nq>(dydt) = qdot;
     vmap<nq>(dydt + nq) = vdot;
@@ -79,32 +79,18 @@ class BraunGoldfarbFormulation final : public MechanicalFormulationBase<Model> {
   }
 
  private:
-  // R^-1 N_v (C_e N_v)^+ (b_ev - A_ev a - Phi_ev / dt)
-  VecQ energy_correction(const VecQ& a, double inv_dt) {
-    const VecQ ce = pinv_v_.row_times_r_inverse(terms_.energy_grad_v);  // C_e^T
-    double b_e = -terms_.energy_rate_free;
-    double Ae_a = terms_.energy_grad_v.dot(a);
-    double phi_e = terms_.energy - energy0_;
-    VecQ u = ce;  // (C_e N_v)^T = N_v C_e^T
-    if constexpr (nc > 0) {
-      // w^T = C_e C_v^+ : a row of length nc; w = (C_v^+)^T C_e^T.
-      // Computed through C_v^+ applied to unit vectors would be costly; use
-      // (C_v^+)^T x = (C_v^T)^+ x, i.e. the COD of C_v^T. Equivalent and
-      // cheaper: project C_e^T on the row space of C_v: P = C_v^+ C_v.
-      const auto& Cv = pinv_v_.C();
-      const VecQ proj = pinv_v_.pinv(Cv * ce);  // C_v^+ C_v C_e^T
-      u = ce - proj;                            // N_v C_e^T
-      // C_e C_v^+ x = (C_v^+^T C_e^T) . x; with y = C_v^+^T C_e^T solving
-      // C_v^T y ~ ... we use the identity C_e C_v^+ x = C_e^T . (C_v^+ x).
-      const Vec<double, nc> bv = -terms_.gamma;
-      b_e -= ce.dot(pinv_v_.pinv(bv));
-      Ae_a -= ce.dot(pinv_v_.pinv(terms_.A * a));
-      phi_e -= ce.dot(pinv_v_.pinv(terms_.velocity));
-    }
+  // R^-1 N_v (C_e N_v)^+ (b_ev - A_ev a - Phi_ev / dt). Since
+  // (*)_ev = (*)_e - C_e C_v^+ (*)_v, the bracket is
+  // (b_e - A_e a - Phi_e / dt) - C_e w with w = C_v^+ (b_v - A_v a - vel / dt).
+  VecQ energy_correction(const VecQ& a, const VecQ& w, double inv_dt) {
+    const VecQ ce = mass_.rt_inverse(terms_.energy_grad_v);  // C_e^T
+    VecQ u = ce;                                              // (C_e N_v)^T = N_v C_e^T
+    if constexpr (nc > 0) u -= pinv_v_.pinv(pinv_v_.C() * ce);
     const double uu = u.squaredNorm();
     if (!(uu > tol_)) return VecQ::Zero();
-    const double rhs = b_e - Ae_a - inv_dt * phi_e;
-    return pinv_v_.r_inverse(u * (rhs / uu));
+    const double rhs = -terms_.energy_rate_free - terms_.energy_grad_v.dot(a) -
+                       inv_dt * (terms_.energy - energy0_) - ce.dot(w);
+    return mass_.r_inverse(u * (rhs / uu));
   }
 
   double dt_;
@@ -112,6 +98,7 @@ class BraunGoldfarbFormulation final : public MechanicalFormulationBase<Model> {
   double tol_;
   double energy0_ = 0;
   MechanicalTerms<Model> terms_;
+  MassFactor<nq> mass_;  // one factorization of M per evaluation, shared by both row sets
   WeightedPinv<(nc > 0 ? nc : 1), nq> pinv_v_;
   WeightedPinv<(nh > 0 ? nh : 1), nq> pinv_q_;
 };

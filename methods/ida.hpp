@@ -116,13 +116,14 @@ class MechanicalDaeFormulation final : public MechanicalFormulationBase<Model>, 
       MechanicalTerms<Model> terms;
       Eigen::Matrix<double, nq, nq> M;
       if constexpr (nh > 0) {
+        MassFactor<nq> mass;
         WeightedPinv<nh, nq> pinv;
         // -dq/dtau at q; false if M is singular.
         auto flow = [&](const VecQ& at, VecQ& direction) {
           terms.evaluate_position(this->model_, t0, at);
           this->model_.mass(t0, at, M);
-          if (!pinv.factor_mass(M)) return false;
-          pinv.set_rows(terms.A.template topRows<nh>());
+          if (!mass.factor(M)) return false;
+          pinv.set_rows(mass, terms.A.template topRows<nh>());
           direction = pinv.correction(terms.phi);
           return true;
         };
@@ -148,9 +149,10 @@ class MechanicalDaeFormulation final : public MechanicalFormulationBase<Model>, 
       terms.evaluate_velocity(this->model_, t0, q, v);
       if (terms.velocity.template lpNorm<Eigen::Infinity>() > kTol) {
         this->model_.mass(t0, q, M);
+        MassFactor<nq> velocity_mass;
         WeightedPinv<nc, nq> velocity_pinv;
-        if (velocity_pinv.factor_mass(M)) {
-          velocity_pinv.set_rows(terms.A);
+        if (velocity_mass.factor(M)) {
+          velocity_pinv.set_rows(velocity_mass, terms.A);
           v -= velocity_pinv.correction(terms.velocity);
         }
       }

@@ -33,13 +33,13 @@ class IndexOneFormulation : public MechanicalFormulationBase<Model> {
   bool rhs(double t, const double* y, double* dydt) override {
     const VecQ q = vmap<nq>(y), v = vmap<nq>(y + nq);
     terms_.evaluate(this->model_, t, q, v, false);
-    if (!pinv_.factor_mass(terms_.M)) {
+    if (!mass_.factor(terms_.M)) {
       this->failure_ = "mass matrix not positive definite at t = " + std::to_string(t);
       return false;
     }
-    VecQ a = pinv_.mass_solve(terms_.Q);
+    VecQ a = mass_.solve(terms_.Q);
     if constexpr (nc > 0) {
-      pinv_.set_rows(terms_.A);
+      pinv_.set_rows(mass_, terms_.A);
       a += pinv_.correction(-terms_.gamma - terms_.A * a);
     }
     vmap<nq>(dydt) = v;
@@ -56,20 +56,20 @@ class IndexOneFormulation : public MechanicalFormulationBase<Model> {
       auto q = vmap<nq>(y);
       auto v = vmap<nq>(y + nq);
       this->model_.mass(t, VecQ(q), M_);
-      if (!pos_pinv_.factor_mass(M_)) return false;
+      if (!post_mass_.factor(M_)) return false;
       if constexpr (nh > 0) {
         for (int it = 0; it < max_iter_; ++it) {
           pos_terms_.evaluate_position(this->model_, t, q);
           if (pos_terms_.phi.template lpNorm<Eigen::Infinity>() <= tol_) break;
-          pos_pinv_.set_rows(pos_terms_.A.template topRows<nh>());
+          pos_pinv_.set_rows(post_mass_, pos_terms_.A.template topRows<nh>());
           q -= pos_pinv_.correction(pos_terms_.phi);
         }
       }
       // Velocity constraints are affine in v: one correction is exact.
       this->model_.mass(t, VecQ(q), M_);
-      if (!vel_pinv_.factor_mass(M_)) return false;
+      if (!post_mass_.factor(M_)) return false;
       vel_terms_.evaluate_velocity(this->model_, t, q, v);
-      vel_pinv_.set_rows(vel_terms_.A);
+      vel_pinv_.set_rows(post_mass_, vel_terms_.A);
       v -= vel_pinv_.correction(vel_terms_.velocity);
       return true;
     }
@@ -81,6 +81,7 @@ class IndexOneFormulation : public MechanicalFormulationBase<Model> {
   int max_iter_;
   MechanicalTerms<Model> terms_, pos_terms_, vel_terms_;
   Eigen::Matrix<double, nq, nq> M_;
+  MassFactor<nq> mass_, post_mass_;
   WeightedPinv<nc, nq> pinv_, vel_pinv_;
   WeightedPinv<(nh > 0 ? nh : 1), nq> pos_pinv_;
 };

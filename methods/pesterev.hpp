@@ -23,20 +23,24 @@ inline double binomial(int n, int k) {
   for (int i = 1; i <= k; ++i) r = r * (n - k + i) / i;
   return r;
 }
+// lambda_<constraint> if given (> 0), else lambda.
+inline double lambda_for(const Params& params, const std::string& constraint) {
+  const double own = params.get("lambda_" + constraint);
+  return own > 0 ? own : params.get("lambda");
+}
 }  // namespace pesterev_detail
 
 template <class Model>
-class PesterevFormulation final : public Formulation {
- public:
-  static constexpr int n = Model::kStates;
-  static constexpr int m = Model::kInputs;
+class PesterevFormulation final : public AffineFormulationBase<Model> {
+  using Base = AffineFormulationBase<Model>;
 
-  PesterevFormulation(const Model& model, const Params& params)
-      : model_(model), constraints_(model.constraints()) {
-    const double lambda = params.get("lambda");
+ public:
+  using Base::m;
+  using Base::n;
+
+  PesterevFormulation(const Model& model, const Params& params) : Base(model) {
     for (int i = 0; i < m; ++i) {
-      const std::string key = "lambda_" + constraints_[i].name;
-      const double li = params.get(key) > 0 ? params.get(key) : lambda;
+      const double li = pesterev_detail::lambda_for(params, this->constraints_[i].name);
       const int r = Model::kRelativeDegree[i];
       // gains_(i, k) multiplies L_F^k f_i.
       for (int k = 0; k < LieJet<Model>::kMaxDegree; ++k)
@@ -45,31 +49,23 @@ class PesterevFormulation final : public Formulation {
     // Relative degrees are declared by the model; check them where the run
     // starts: A(X0) must be nonsingular.
     Vec<double, n> X0;
-    model_.initial_state(X0);
-    jet_.evaluate(model_, 0.0, X0);
+    this->model_.initial_state(X0);
+    jet_.evaluate(this->model_, 0.0, X0);
     lu_.compute(jet_.A);
     if (!(lu_.rcond() > 1e-12))
       throw UsageError("pesterev: declared relative degrees do not hold at the initial state "
                        "(A(X0) singular, rcond " + std::to_string(lu_.rcond()) + ")");
   }
 
-  std::string formulation_name() const override { return model_.formulation_name(); }
-  int dimension() const override { return n; }
-  void initial_state(double* y) const override {
-    Vec<double, n> X;
-    model_.initial_state(X);
-    vmap<n>(y) = X;
-  }
-
   bool rhs(double t, const double* y, double* dydt) override {
     const Eigen::Map<const Vec<double, n>> X(y);
-    jet_.evaluate(model_, t, X);
+    jet_.evaluate(this->model_, t, X);
     Vec<double, m> phi = jet_.top;
     for (int i = 0; i < m; ++i) phi(i) += jet_.lower.row(i).dot(gains_.row(i));
     lu_.compute(jet_.A);
     const double rcond = lu_.rcond();
     if (!(rcond > 1e-14)) {
-      failure_ = "reaction matrix A(X) singular (rcond " + std::to_string(rcond) + ") at t = " +
+      this->failure_ = "reaction matrix A(X) singular (rcond " + std::to_string(rcond) + ") at t = " +
                  std::to_string(t);
       return false;
     }
@@ -77,32 +73,16 @@ class PesterevFormulation final : public Formulation {
     vmap<n>(dydt) = jet_.F + jet_.B * N;
     return true;
   }
-  const std::string& failure_reason() const override { return failure_; }
-
-  const std::vector<ConstraintInfo>& constraints() const override { return constraints_; }
-  void residuals(double t, const double* y, double* out) const override {
-    Vec<double, m> f;
-    model_.outputs(t, Eigen::Map<const Vec<double, n>>(y).eval(), f);
-    vmap<m>(out) = f;
-  }
-  void to_canonical(double t, const double* y, double* c) const override {
-    model_.to_canonical(t, Eigen::Map<const Vec<double, n>>(y).eval(), c);
-  }
   bool has_condition_number() const override { return true; }
   double condition_number(double t, const double* y) override {
-    jet_.evaluate(model_, t, Eigen::Map<const Vec<double, n>>(y));
-    Eigen::JacobiSVD<Eigen::Matrix<double, m, m>> svd(jet_.A);
-    const auto& s = svd.singularValues();
-    return s(m - 1) > 0 ? s(0) / s(m - 1) : std::numeric_limits<double>::infinity();
+    jet_.evaluate(this->model_, t, vmap<n>(y));
+    return condition_number_of<m>(jet_.A);
   }
 
  private:
-  Model model_;
-  std::vector<ConstraintInfo> constraints_;
   Eigen::Matrix<double, m, LieJet<Model>::kMaxDegree> gains_;
   LieJet<Model> jet_;
   Eigen::PartialPivLU<Eigen::Matrix<double, m, m>> lu_;
-  std::string failure_;
 };
 
 // Lambda-feedback on a mechanical model, written directly in its terms. With
@@ -123,11 +103,7 @@ class PesterevMechanicalFormulation final : public MechanicalFormulationBase<Mod
   using typename Base::VecQ;
 
   PesterevMechanicalFormulation(const Model& model, const Params& params) : Base(model) {
-    const double lambda = params.get("lambda");
-    for (int i = 0; i < nc; ++i) {
-      const std::string key = "lambda_" + this->constraints_[i].name;
-      lambda_(i) = params.get(key) > 0 ? params.get(key) : lambda;
-    }
+    for (int i = 0; i < nc; ++i) lambda_(i) = pesterev_detail::lambda_for(params, this->constraints_[i].name);
     VecQ q, v;
     model.initial_state(q, v);
     build(0.0, q, v);
@@ -160,9 +136,7 @@ class PesterevMechanicalFormulation final : public MechanicalFormulationBase<Mod
   bool has_condition_number() const override { return true; }
   double condition_number(double t, const double* y) override {
     if (!build(t, vmap<nq>(y).eval(), vmap<nq>(y + nq).eval())) return NAN;
-    Eigen::JacobiSVD<Eigen::Matrix<double, nc, nc>> svd(Amat_);
-    const auto& s = svd.singularValues();
-    return s(nc - 1) > 0 ? s(0) / s(nc - 1) : std::numeric_limits<double>::infinity();
+    return condition_number_of<nc>(Amat_);
   }
 
  private:

@@ -34,36 +34,16 @@ class UnconstrainedMechanical final : public MechanicalFormulationBase<Model> {
 };
 
 template <class Model>
-class UnconstrainedAffine final : public Formulation {
+class UnconstrainedAffine final : public AffineFormulationBase<Model> {
  public:
-  static constexpr int n = Model::kStates;
-  explicit UnconstrainedAffine(const Model& model) : model_(model), constraints_(model.constraints()) {}
-  std::string formulation_name() const override { return model_.formulation_name(); }
-  int dimension() const override { return n; }
-  void initial_state(double* y) const override {
-    Vec<double, n> X;
-    model_.initial_state(X);
-    vmap<n>(y) = X;
-  }
+  using AffineFormulationBase<Model>::n;
+  explicit UnconstrainedAffine(const Model& model) : AffineFormulationBase<Model>(model) {}
   bool rhs(double t, const double* y, double* dydt) override {
     Vec<double, n> F;
-    model_.drift(t, vmap<n>(y).eval(), F);
+    this->model_.drift(t, vmap<n>(y).eval(), F);
     vmap<n>(dydt) = F;
     return true;
   }
-  const std::vector<ConstraintInfo>& constraints() const override { return constraints_; }
-  void residuals(double t, const double* y, double* out) const override {
-    Vec<double, Model::kInputs> f;
-    model_.outputs(t, vmap<n>(y).eval(), f);
-    vmap<Model::kInputs>(out) = f;
-  }
-  void to_canonical(double t, const double* y, double* c) const override {
-    model_.to_canonical(t, vmap<n>(y).eval(), c);
-  }
-
- private:
-  Model model_;
-  std::vector<ConstraintInfo> constraints_;
 };
 
 }  // namespace cstab

@@ -2,6 +2,8 @@
 // one-line message naming the bad flag, and no output files; a good run
 // writes summary.csv and series.csv with the documented columns.
 #include <gtest/gtest.h>
+
+#include "tests/test_util.hpp"
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -19,43 +21,18 @@ namespace fs = std::filesystem;
 
 namespace {
 
-std::string quote(const std::string& s) {
-  std::string out = "'";
-  for (char c : s) {
-    if (c == '\'') out += "'\\''";
-    else out += c;
-  }
-  return out + "'";
-}
+using cstab::testing::exit_code;
+using cstab::testing::quote;
+using cstab::testing::slurp;
 
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
+// A scratch folder per test, removed afterwards.
+struct Scratch : cstab::testing::Scratch {
+  Scratch() : cstab::testing::Scratch("cstab_cli") {}
+};
 
 struct Outcome {
   int code = -1;
   std::string out, err;
-};
-
-// A scratch folder per test, removed afterwards.
-class Scratch {
- public:
-  Scratch() {
-    std::string tmpl = (fs::temp_directory_path() / "cstab_cli_XXXXXX").string();
-    if (!::mkdtemp(tmpl.data())) throw std::runtime_error("mkdtemp failed");
-    dir_ = tmpl;
-  }
-  ~Scratch() {
-    std::error_code ec;
-    fs::remove_all(dir_, ec);
-  }
-  const fs::path& dir() const { return dir_; }
-
- private:
-  fs::path dir_;
 };
 
 Outcome run_cli(const std::vector<std::string>& args, const fs::path& scratch) {

@@ -1,6 +1,8 @@
 // plots/wheel.gp on a real (short) run's series.csv: every PNG is written,
 // is a PNG, and gnuplot reports no error.
 #include <gtest/gtest.h>
+
+#include "tests/test_util.hpp"
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -16,39 +18,13 @@ namespace fs = std::filesystem;
 
 namespace {
 
-std::string quote(const std::string& s) {
-  std::string out = "'";
-  for (char c : s) {
-    if (c == '\'') out += "'\\''";
-    else out += c;
-  }
-  return out + "'";
-}
+using cstab::testing::exit_code;
+using cstab::testing::quote;
+using cstab::testing::slurp;
 
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
-int exit_code(int status) { return WIFEXITED(status) ? WEXITSTATUS(status) : -1; }
-
-class Scratch {
- public:
-  Scratch() {
-    std::string tmpl = (fs::temp_directory_path() / "cstab_plots_XXXXXX").string();
-    if (!::mkdtemp(tmpl.data())) throw std::runtime_error("mkdtemp failed");
-    dir_ = tmpl;
-  }
-  ~Scratch() {
-    std::error_code ec;
-    fs::remove_all(dir_, ec);
-  }
-  const fs::path& dir() const { return dir_; }
-
- private:
-  fs::path dir_;
+// A scratch folder per test, removed afterwards.
+struct Scratch : cstab::testing::Scratch {
+  Scratch() : cstab::testing::Scratch("cstab_plots") {}
 };
 
 bool have_gnuplot() { return std::system("command -v gnuplot >/dev/null 2>&1") == 0; }
