@@ -4,6 +4,7 @@
 #include <sstream>
 
 #include "cli/args.hpp"
+#include "cli/gate_command.hpp"
 #include "cli/stability_command.hpp"
 #include "cli/matrix_commands.hpp"
 #include "harness/format.hpp"
@@ -30,6 +31,11 @@ usage:
                runs a benchmark matrix (default: the embedded one; docs/matrix.md)
   cstab merge OUT SHARD_DIR... [--jobs N] [--no-report]
   cstab report DIR [--jobs N] [--no-plots]
+  cstab gate [--thresholds FILE] [--csv OUT] DIR
+               checks a matrix results folder against accuracy thresholds (docs/gate.md);
+               exit 1 if any check fails
+  cstab gate --update [--factor F] [--time-factor T] [--thresholds FILE] DIR
+  cstab gate --init FILE [--factor F] DIR
 
 Exit codes: 0 success (a diverged run is a recorded result), 2 bad input, 1 internal error.
 See README.md for every column of summary.csv and series.csv.
@@ -146,7 +152,8 @@ int dispatch(const std::string& command, const std::vector<std::string>& args) {
   if (command == "matrix") return cmd_matrix(args);
   if (command == "merge") return cmd_merge(args);
   if (command == "report") return cmd_report(args);
-  throw UsageError("unknown command '" + command + "' (known: list, run, matrix, merge, report)");
+  if (command == "gate") return cmd_gate(args);
+  throw UsageError("unknown command '" + command + "' (known: list, run, stability, matrix, merge, report, gate)");
 }
 
 }  // namespace cstab::cli
