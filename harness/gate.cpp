@@ -35,9 +35,9 @@ constexpr double kValueFloor = 1e-15;
 // The known columns, in --init order. Keep in sync with the CSVReader below.
 const std::vector<std::string> kColumns = {
     "name",          "sweep",          "problem",          "method",           "formulation",
-    "integrator",    "params",         "setting",          "t_end",            "perturb",
-    "status",        "max_residual",   "max_final_residual", "max_energy_drift", "max_integral_drift",
-    "max_ref_error", "min_ref_scd",    "baseline",         "max_time_ratio",   "note"};
+    "integrator",    "params",         "setting",          "t_end",            "status",
+    "max_residual",  "max_final_residual", "max_energy_drift", "max_integral_drift", "max_ref_error",
+    "min_ref_scd",   "max_recovery_time", "baseline",       "max_time_ratio",   "note"};
 constexpr unsigned kColumnCount = 20;
 
 const std::vector<std::string> kRequired = {"problem", "method", "integrator", "setting"};
@@ -152,6 +152,7 @@ struct CaseResult {
   std::string reason;
   double max_residual = kNaN, max_final_residual = kNaN, max_energy_drift = kNaN, max_integral_drift = kNaN;
   double ref_error = kNaN, ref_scd = kNaN;
+  double recovery_time = kNaN;  // NaN: did not recover (or the case had no consistent end)
   double median_wall = kNaN;
 };
 
@@ -192,6 +193,7 @@ CaseResult load_case(const std::string& dir, const CaseEntry& entry) {
           col.compare(col.size() - 6, 6, "_drift") == 0)
         r.max_integral_drift = nan_max(r.max_integral_drift, cell_number(t, i, col));
     r.ref_error = nan_max(r.ref_error, cell_number(t, i, "ref_error"));
+    r.recovery_time = nan_max(r.recovery_time, cell_number(t, i, "recovery_time"));
     const double scd = cell_number(t, i, "ref_scd");
     if (!std::isnan(scd)) r.ref_scd = std::isnan(r.ref_scd) ? scd : std::min(r.ref_scd, scd);
     if (st == "ok") walls.push_back(cell_number(t, i, "wall_seconds"));
@@ -209,8 +211,7 @@ bool matches(const ThresholdRow& row, const CaseEntry& e) {
       e.formulation != row.formulation || e.params != row.params || e.setting != row.setting)
     return false;
   if (!std::isnan(row.t_end) && e.t_end != row.t_end) return false;
-  if (!row.sweep.empty() && e.sweep != row.sweep) return false;
-  return row.perturb == 0;  // results folders record unperturbed starts only
+  return row.sweep.empty() || e.sweep == row.sweep;
 }
 
 struct Match {
@@ -270,6 +271,7 @@ const BoundSpec kBounds[] = {
     {"max_integral_drift", &ThresholdRow::max_integral_drift, &CaseResult::max_integral_drift, false},
     {"max_ref_error", &ThresholdRow::max_ref_error, &CaseResult::ref_error, false},
     {"min_ref_scd", &ThresholdRow::min_ref_scd, &CaseResult::ref_scd, true},
+    {"max_recovery_time", &ThresholdRow::max_recovery_time, &CaseResult::recovery_time, false},
     {"max_time_ratio", &ThresholdRow::max_time_ratio, nullptr, false},
 };
 
@@ -305,7 +307,6 @@ std::string ThresholdRow::label() const {
   if (!sweep.empty()) s += " sweep=" + sweep;
   if (!params.empty()) s += " [" + params + "]";
   if (!std::isnan(t_end)) s += " t_end=" + format_short(t_end);
-  if (perturb != 0) s += " perturb=" + format_short(perturb);
   return s;
 }
 
@@ -346,9 +347,9 @@ ThresholdsFile parse_thresholds(const std::string& text, const std::string& file
   std::map<std::string, int> key_line, name_line;
   try {
     reader.read_header(io::ignore_missing_column, "name", "sweep", "problem", "method", "formulation", "integrator",
-                       "params", "setting", "t_end", "perturb", "status", "max_residual", "max_final_residual",
-                       "max_energy_drift", "max_integral_drift", "max_ref_error", "min_ref_scd", "baseline",
-                       "max_time_ratio", "note");
+                       "params", "setting", "t_end", "status", "max_residual", "max_final_residual",
+                       "max_energy_drift", "max_integral_drift", "max_ref_error", "min_ref_scd",
+                       "max_recovery_time", "baseline", "max_time_ratio", "note");
     char* cells[kColumnCount];
     while (true) {
       std::fill(cells, cells + kColumnCount, nullptr);
@@ -384,10 +385,6 @@ ThresholdsFile parse_thresholds(const std::string& text, const std::string& file
       if (!text_of("t_end").empty()) {
         row.t_end = parse_number(text_of("t_end"), at("t_end"), "t_end");
         if (!(row.t_end > 0)) throw UsageError(at("t_end") + ": t_end: must be > 0");
-      }
-      if (!text_of("perturb").empty()) {
-        row.perturb = parse_number(text_of("perturb"), at("perturb"), "perturb");
-        if (row.perturb < 0) throw UsageError(at("perturb") + ": perturb: must be >= 0");
       }
       if (!text_of("status").empty()) {
         row.status = text_of("status");
@@ -492,13 +489,17 @@ GateOutcome evaluate_gate(const ThresholdsFile& file, const std::string& dir) {
   std::map<std::string, CaseResult> by_name;  // row name -> its case (for baselines)
   std::vector<CaseResult> results(file.rows.size());
   std::vector<std::string> problems(file.rows.size());
+  std::set<const CaseEntry*> named;
   for (size_t i = 0; i < file.rows.size(); ++i) {
     const Match m = find_case(file.rows[i], entries);
+    if (m.entry) named.insert(m.entry);
     if (m.entry) results[i] = load_case(dir, *m.entry);
     problems[i] = m.entry ? (results[i].complete ? "" : "case " + m.entry->id + " has no complete result")
                           : m.problem;
     if (!file.rows[i].name.empty()) by_name[file.rows[i].name] = results[i];
   }
+  for (const auto& e : entries)
+    if (!named.count(&e) && kStatuses.count(load_case(dir, e).status)) ++out.unchecked_cases;  // n/a ones aside
   for (size_t i = 0; i < file.rows.size(); ++i) {
     const ThresholdRow& row = file.rows[i];
     const CaseResult& r = results[i];
@@ -578,7 +579,10 @@ std::string format_gate_table(const GateOutcome& outcome) {
     line(rows[i]);
     if (!outcome.checks[i].note.empty()) s << "      " << outcome.checks[i].note << "\n";
   }
-  s << "gate: " << outcome.checks.size() << " checks, " << outcome.failed << " failed\n";
+  s << "gate: " << outcome.checks.size() << " checks, " << outcome.failed << " failed";
+  if (outcome.unchecked_cases)
+    s << " (" << outcome.unchecked_cases << " cases of the folder have no thresholds: not checked)";
+  s << "\n";
   return s.str();
 }
 

@@ -7,17 +7,20 @@
 // of the results folder's cases.csv, and gives bounds; an empty cell is not
 // checked:
 //
-//   key:    problem, method, integrator, setting (required), formulation,
+//   key:    problem, method, integrator, setting (required; a perturbed
+//           start is part of it: "step=0.001;perturb=0.001"), formulation,
 //           params (the given parameters, "a=1;b=2"; empty: defaults),
-//           t_end (empty: any), sweep (empty: any), perturb (empty: 0),
+//           t_end (empty: any), sweep (empty: any),
 //           name (a label other rows can name as their timing baseline)
 //   bounds: status (expected status, default ok), max_residual,
 //           max_final_residual (the residual at t_end: what stabilization
-//           left of an inconsistent start), max_energy_drift, max_integral_drift (largest first integral
-//           other than energy), max_ref_error, min_ref_scd (significant
-//           correct digits), max_time_ratio with baseline (median wall time
-//           over the baseline row's median wall time, same results folder:
-//           never absolute seconds)
+//           left of drift or of an inconsistent start), max_energy_drift,
+//           max_integral_drift (largest first integral other than energy),
+//           max_ref_error, min_ref_scd (significant correct digits),
+//           max_recovery_time (from an inconsistent start, to the run's
+//           recovery threshold), max_time_ratio with baseline (median wall
+//           time over the baseline row's median wall time, same results
+//           folder: never absolute seconds)
 #pragma once
 
 #include <limits>
@@ -33,7 +36,6 @@ struct ThresholdRow {
   std::vector<std::string> fields;  // cells in the file's column order
   std::string name, sweep, problem, method, formulation, integrator, params, setting, baseline;
   double t_end = std::numeric_limits<double>::quiet_NaN();  // NaN: any
-  double perturb = 0;
   std::string status = "ok";
   double max_residual = std::numeric_limits<double>::quiet_NaN();  // NaN: not checked
   double max_final_residual = std::numeric_limits<double>::quiet_NaN();
@@ -41,6 +43,7 @@ struct ThresholdRow {
   double max_integral_drift = std::numeric_limits<double>::quiet_NaN();
   double max_ref_error = std::numeric_limits<double>::quiet_NaN();
   double min_ref_scd = std::numeric_limits<double>::quiet_NaN();
+  double max_recovery_time = std::numeric_limits<double>::quiet_NaN();
   double max_time_ratio = std::numeric_limits<double>::quiet_NaN();
   std::string label() const;  // "wheel baumgarte rk4 step=0.001 [alpha=5]"
 };
@@ -75,6 +78,7 @@ struct GateCheck {
 struct GateOutcome {
   std::vector<GateCheck> checks;
   size_t failed = 0;
+  size_t unchecked_cases = 0;  // runs of the folder no row names (not a failure; n/a cases aside)
 };
 
 // Checks results folder `dir` (a `cstab matrix` output) against `file`.
