@@ -217,6 +217,23 @@ int cmd_matrix(const std::vector<std::string>& argv) {
   std::cout << "matrix: " << stats.total << " cases: " << stats.run << " run, " << stats.cached << " cached, in "
             << secs << " s; " << (outcome_text.empty() ? "no results" : outcome_text) << "; " << out
             << "/summary.csv\n";
+  if (stats.interrupted_by) {
+    // Finished cases are kept (and summarized above); the report waits for
+    // a complete run.
+    std::cout.flush();
+    std::cerr << "cstab matrix: interrupted by " << stop_signal_name(stats.interrupted_by) << ": "
+              << stats.total - stats.unfinished << " of " << stats.total << " cases finished and kept in " << out
+              << "/summary.csv, " << stats.unfinished << " unfinished; run the same command again to resume (exit "
+              << 128 + stats.interrupted_by << ")\n";
+    return 128 + stats.interrupted_by;
+  }
+  if (stats.unfinished) {
+    std::cout.flush();
+    std::cerr << "cstab matrix: " << stats.unfinished << " of " << stats.total
+              << " cases unfinished (their workers were stopped by a signal); run the same command again to "
+                 "complete them (exit 1)\n";
+    return 1;
+  }
   if (shard_n > 1)
     std::cout << "matrix: shard " << shard_k << "/" << shard_n << " done; join the shards with `cstab merge OUT "
               << "SHARD_DIR...`\n";

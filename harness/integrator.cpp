@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstring>
 
+#include "format.hpp"
 #include "params.hpp"
 
 namespace cstab {
@@ -180,6 +181,22 @@ class AdamsPece final : public FixedStep {
   bool have_history_ = false;
 };
 
+// What a GSL odeiv2 evolve status means, in words (gsl_strerror alone says
+// "failure" for the step-size underflow).
+std::string gsl_failure_words(int status, double t, double h) {
+  const std::string at = " at t = " + format_short(t);
+  switch (status) {
+    case GSL_FAILURE:
+      return "step-size underflow: no acceptable step above machine precision (last try " + format_short(h) + ")" + at;
+    case GSL_EBADFUNC: return "the right-hand side failed" + at;
+    case GSL_ENOMEM: return "GSL: out of memory" + at;
+    case GSL_EMAXITER: return "GSL: too many iterations (the implicit solve did not converge)" + at;
+    case GSL_ENOPROG: return "GSL: no progress (step size at its minimum)" + at;
+    default:
+      return std::string("GSL: ") + gsl_strerror(status) + " (GSL error " + std::to_string(status) + ")" + at;
+  }
+}
+
 // GSL odeiv2 adaptive schemes, driven one step at a time via evolve_apply.
 class GslAdaptive final : public Integrator {
  public:
@@ -208,13 +225,14 @@ class GslAdaptive final : public Integrator {
                                                t_limit, &h_, y_.data());
     rejected_ += long(driver_->e->failed_steps - failed_before);
     if (status != GSL_SUCCESS) {
-      if (failure_.empty()) failure_ = std::string("GSL: ") + gsl_strerror(status);
+      if (failure_.empty()) failure_ = gsl_failure_words(status, t_, h_);
       return StepOutcome::kFailed;
     }
     h_used_ = t_ - t_before;
     ++steps_;
     if (!(h_used_ > 1e-14 * std::max(1.0, std::abs(t_))) && t_ < t_limit) {
-      failure_ = "step-size underflow at t = " + std::to_string(t_);
+      failure_ = "step-size underflow: step " + format_short(h_used_) + " at t = " + format_short(t_) +
+                 " (tolerances too tight, or the solution is not smooth here)";
       return StepOutcome::kFailed;
     }
     return StepOutcome::kOk;

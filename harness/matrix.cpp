@@ -502,6 +502,9 @@ std::string CaseEntry::label() const {
   return s;
 }
 
+// Limits on one matrix (the default one has under 1000 cases).
+constexpr size_t kMaxCases = 100000, kMaxCombinations = 1000000;
+
 Expansion expand_matrix(const MatrixFile& file, const MatrixCatalog& catalog) {
   Expansion out;
   const MatrixSection* defaults = nullptr;
@@ -510,7 +513,7 @@ Expansion expand_matrix(const MatrixFile& file, const MatrixCatalog& catalog) {
     if (sec.kind == "defaults") defaults = &sec;
   }
   std::set<std::string> seen_ids, seen_names;
-  size_t duplicates = 0;
+  size_t duplicates = 0, combinations = 0;
   int sweep_number = 0;
   for (const auto& sec : file.sections) {
     if (sec.kind != "sweep") continue;
@@ -669,7 +672,10 @@ Expansion expand_matrix(const MatrixFile& file, const MatrixCatalog& catalog) {
     if (set.find("sample_every")) check("sample_every", sample_every >= 0, "must be >= 0 (0: t_end / 1000)");
     if (set.find("blowup")) check("blowup", blowup > 0, "must be > 0");
     if (set.find("observe_every"))
-      check("observe_every", observe_every >= 1 && observe_every == std::floor(observe_every), "must be an integer >= 1");
+      check("observe_every", observe_every >= 1 && observe_every <= 1e9 && observe_every == std::floor(observe_every),
+            "must be an integer in [1, 1e9]");
+    for (const auto* v : times)
+      if (!(v->number > 0)) throw MatrixError(v->where, "times: " + v->text + " must be > 0");
     if (set.find("repeats"))
       check("repeats", repeats_num >= 1 && repeats_num <= 1000 && repeats_num == std::floor(repeats_num),
             "must be an integer in [1, 1000]");
@@ -708,6 +714,21 @@ Expansion expand_matrix(const MatrixFile& file, const MatrixCatalog& catalog) {
       param_choices.push_back(std::move(pc));
     }
 
+    for (const auto* f : formulations) {
+      const bool known = std::any_of(problems.begin(), problems.end(), [&](const Problem* p) {
+        const auto& fs = p->info().formulations;
+        return std::any_of(fs.begin(), fs.end(), [&](const FormulationInfo& fi) { return fi.name == f->text; });
+      });
+      if (!known && !problems.empty()) {
+        std::vector<std::string> names;
+        for (const Problem* p : problems)
+          for (const auto& fi : p->info().formulations)
+            if (std::find(names.begin(), names.end(), fi.name) == names.end()) names.push_back(fi.name);
+        throw MatrixError(f->where, "unknown formulation '" + f->text + "'" + suggestion(f->text, names) +
+                                        " for the sweep's problems (known: " + join(names, ", ") + ")");
+      }
+    }
+
     // ---- the product ----
     size_t not_applicable = 0;
     for (const Problem* problem : problems) {
@@ -741,6 +762,16 @@ Expansion expand_matrix(const MatrixFile& file, const MatrixCatalog& catalog) {
             }
             continue;
           }
+          const ParamSpec& spec =
+              *std::find_if(specs.begin(), specs.end(), [&](const ParamSpec& s) { return s.name == pc.name; });
+          for (const auto* v : pc.values) {
+            if (spec.bound == Bound::kPositive && !(v->number > 0))
+              throw MatrixError(v->where, "param." + pc.name + " = " + v->text + ": must be > 0 for method '" +
+                                              method->name + "'");
+            if (spec.bound == Bound::kNonNegative && !(v->number >= 0))
+              throw MatrixError(v->where, "param." + pc.name + " = " + v->text + ": must be >= 0 for method '" +
+                                              method->name + "'");
+          }
           pc.used = true;
           applying.push_back(&pc);
         }
@@ -748,11 +779,23 @@ Expansion expand_matrix(const MatrixFile& file, const MatrixCatalog& catalog) {
         for (const auto* f : formulations) forms.push_back(f->text);
         if (forms.empty()) forms.push_back("");
         for (const std::string& form : forms) {
+          if (!form.empty()) {
+            try {
+              problem->method_params(method->name, form);
+            } catch (const UsageError&) {
+              note(method->name + " on " + info.name + " has no formulation '" + form + "': skipped");
+              continue;
+            }
+          }
           for (const IntegratorInfo* integ : integrators) {
             for (const TEnd& te : t_ends) {
               double t_end = te.value;
               if (te.mode == "ref") t_end = info.reference_time > 0 ? info.reference_time : info.default_t_end;
               if (te.mode == "default") t_end = info.default_t_end;
+              for (const auto* v : times)
+                if (v->number > t_end)
+                  throw MatrixError(v->where, "times: " + v->text + " is beyond t_end " + format_short(t_end) +
+                                                  " (problem '" + info.name + "')");
               // step settings
               std::vector<StepSettings> settings;
               if (integ->fixed_step) {
@@ -773,6 +816,11 @@ Expansion expand_matrix(const MatrixFile& file, const MatrixCatalog& catalog) {
               std::vector<size_t> pick(applying.size(), 0);
               while (true) {
                 for (const StepSettings& st : settings) {
+                  // A typo like 10 arrays of 100 values must not eat the machine.
+                  if (++combinations > kMaxCombinations || out.cases.size() >= kMaxCases)
+                    throw MatrixError(sec.where, "the matrix expands to more than " + std::to_string(kMaxCases) +
+                                                     " cases (or " + std::to_string(kMaxCombinations) +
+                                                     " combinations): split it into several files");
                   MatrixCase c;
                   RunConfig& cfg = c.config;
                   cfg.problem = info.name;

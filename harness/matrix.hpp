@@ -153,6 +153,8 @@ struct MatrixRunOptions {
 struct MatrixRunStats {
   size_t total = 0, run = 0, cached = 0, failed = 0, diverged = 0;
   size_t not_applicable = 0;  // rejected by the harness before running (status "invalid")
+  size_t unfinished = 0;      // not run or killed unfinished (interrupted): rerun next time
+  int interrupted_by = 0;     // SIGINT, SIGTERM or SIGHUP that stopped the matrix; 0: ran to the end
   double seconds = 0;
 };
 
@@ -162,8 +164,17 @@ struct MatrixRunStats {
 // DIR/cases/<id>/{summary.csv, series.csv, key.txt}; key.txt last, so a
 // folder without it is incomplete. Progress goes to `log`: one updating line
 // on a terminal, plain lines otherwise.
+//
+// SIGINT, SIGTERM or SIGHUP (while it runs) stop the matrix cleanly: no new
+// case starts, running workers get SIGTERM (SIGKILL after a grace period),
+// a worker that still finished keeps its result, the folders of killed ones
+// are removed, and run_matrix returns with `interrupted_by` set. A worker
+// killed by one of these signals from outside is an unfinished case, never a
+// `crashed` result. Rerunning resumes: finished cases are cached.
 MatrixRunStats run_matrix(const std::vector<MatrixCase>& cases, const MatrixRunOptions& options,
                           std::ostream& log, bool log_is_tty);
+// "SIGINT", "SIGTERM", "SIGHUP" (for messages about `interrupted_by`).
+std::string stop_signal_name(int sig);
 
 // The manifest DIR/cases.csv.
 // `selected_cases`: how many cases the run was given before sharding.

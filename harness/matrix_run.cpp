@@ -5,8 +5,10 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <chrono>
 #include <cmath>
+#include <csignal>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
@@ -145,7 +147,64 @@ struct Running {
   Clock::time_point start;
 };
 
+// ---- interruption ----
+// The signal that asked the matrix to stop (0: none). Set by the handler only.
+volatile std::sig_atomic_t g_stop_signal = 0;
+extern "C" void on_stop_signal(int sig) {
+  if (!g_stop_signal) g_stop_signal = sig;
+}
+constexpr int kStopSignals[] = {SIGINT, SIGTERM, SIGHUP};
+
+// A worker killed by one of these was interrupted, not crashed.
+bool is_stop_signal(int sig) { return sig == SIGINT || sig == SIGTERM || sig == SIGHUP; }
+
+// While alive, SIGINT/SIGTERM/SIGHUP set g_stop_signal instead of killing
+// the process; the previous dispositions come back afterwards.
+class StopSignals {
+ public:
+  StopSignals() {
+    g_stop_signal = 0;
+    struct sigaction sa {};
+    sa.sa_handler = on_stop_signal;
+    sigemptyset(&sa.sa_mask);
+    for (size_t i = 0; i < std::size(kStopSignals); ++i) ::sigaction(kStopSignals[i], &sa, &old_[i]);
+  }
+  ~StopSignals() {
+    for (size_t i = 0; i < std::size(kStopSignals); ++i) ::sigaction(kStopSignals[i], &old_[i], nullptr);
+  }
+  StopSignals(const StopSignals&) = delete;
+  StopSignals& operator=(const StopSignals&) = delete;
+
+  // Blocks the stop signals (around fork(), so a child never runs the
+  // parent's handler), and unblocks them.
+  static void block(bool on) {
+    sigset_t set;
+    sigemptyset(&set);
+    for (int sig : kStopSignals) sigaddset(&set, sig);
+    ::sigprocmask(on ? SIG_BLOCK : SIG_UNBLOCK, &set, nullptr);
+  }
+  // In a worker: the default actions, so a stop signal ends it at once.
+  static void defaults_in_child() {
+    for (int sig : kStopSignals) ::signal(sig, SIG_DFL);
+    block(false);
+  }
+
+ private:
+  struct sigaction old_[std::size(kStopSignals)];
+};
+
+const char* signal_name(int sig) {
+  switch (sig) {
+    case SIGINT: return "SIGINT";
+    case SIGTERM: return "SIGTERM";
+    case SIGHUP: return "SIGHUP";
+    default: return "a signal";
+  }
+}
+
 }  // namespace
+
+std::string stop_signal_name(int sig) { return signal_name(sig); }
 
 MatrixRunStats run_matrix(const std::vector<MatrixCase>& cases, const MatrixRunOptions& opt, std::ostream& log,
                           bool tty) {
@@ -153,6 +212,7 @@ MatrixRunStats run_matrix(const std::vector<MatrixCase>& cases, const MatrixRunO
   auto elapsed = [&] { return std::chrono::duration<double>(Clock::now() - start).count(); };
   MatrixRunStats stats;
   stats.total = cases.size();
+  const StopSignals stop_signals;
 
   std::error_code ec;
   fs::create_directories(opt.out_dir + "/cases", ec);
@@ -189,6 +249,7 @@ MatrixRunStats run_matrix(const std::vector<MatrixCase>& cases, const MatrixRunO
   {
     std::set<std::pair<std::string, double>> done;
     for (const MatrixCase* c : todo) {
+      if (g_stop_signal) break;
       const Problem& p = opt.find_problem(c->config.problem);
       const double t = c->config.ref_time < 0 ? p.info().reference_time : c->config.ref_time;
       if (!(t > 0) || t > c->config.t_end || !done.insert({c->config.problem, t}).second) continue;
@@ -221,9 +282,24 @@ MatrixRunStats run_matrix(const std::vector<MatrixCase>& cases, const MatrixRunO
     log << "\r\033[K" << progress_line() << std::flush;
   };
 
+  // A worker that did not finish (stopped by a signal): no result, its
+  // partial folder removed, run again next time.
+  auto unfinished = [&](const MatrixCase& c, const std::string& why) {
+    fs::remove_all(case_folder(opt.out_dir, c.entry.id), ec);
+    ++stats.unfinished;
+    ++finished;
+    if (tty) log << "\r\033[K";
+    log << "[" << (stats.cached + finished) << "/" << stats.total << "] unfinished " << c.entry.label() << "  ("
+        << c.entry.id << ")\n    " << why << ": not recorded, runs again next time\n" << std::flush;
+  };
+
   auto record = [&](const MatrixCase& c, int wait_status, double seconds, bool timed_out) {
     const std::string dir = case_folder(opt.out_dir, c.entry.id);
     std::string outcome, reason;
+    if (!timed_out && WIFSIGNALED(wait_status) && is_stop_signal(WTERMSIG(wait_status))) {
+      unfinished(c, std::string("worker stopped by ") + signal_name(WTERMSIG(wait_status)));
+      return;
+    }
     if (timed_out) {
       outcome = "timeout";
       reason = "killed after " + format_short(c.timeout) + " s (timeout)";
@@ -280,8 +356,8 @@ MatrixRunStats run_matrix(const std::vector<MatrixCase>& cases, const MatrixRunO
     }
   };
 
-  while (next < todo.size() || !running.empty()) {
-    while (running.size() < jobs && next < todo.size()) {
+  while (!g_stop_signal && (next < todo.size() || !running.empty())) {
+    while (!g_stop_signal && running.size() < jobs && next < todo.size()) {
       const MatrixCase& c = *todo[next++];
       const std::string dir = case_folder(opt.out_dir, c.entry.id);
       fs::remove_all(dir, ec);  // nothing stale survives: incomplete until the worker writes key.txt
@@ -290,9 +366,10 @@ MatrixRunStats run_matrix(const std::vector<MatrixCase>& cases, const MatrixRunO
       const Problem& problem = opt.find_problem(c.config.problem);
       log.flush();
       std::fflush(nullptr);
+      StopSignals::block(true);
       const pid_t pid = ::fork();
-      if (pid < 0) throw std::runtime_error("fork failed");
       if (pid == 0) {
+        StopSignals::defaults_in_child();
         int code = kExitFailed;
         try {
           code = run_in_worker(c, problem, dir, key);
@@ -302,6 +379,8 @@ MatrixRunStats run_matrix(const std::vector<MatrixCase>& cases, const MatrixRunO
         std::fflush(nullptr);
         ::_exit(code);
       }
+      StopSignals::block(false);
+      if (pid < 0) throw std::runtime_error(std::string("fork failed: ") + std::strerror(errno));
       running[pid] = {&c, Clock::now()};
       draw(false);
     }
@@ -330,6 +409,39 @@ MatrixRunStats run_matrix(const std::vector<MatrixCase>& cases, const MatrixRunO
     }
     draw(false);
     std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  if (g_stop_signal) {
+    // Stop: nothing new starts; running workers get SIGTERM, SIGKILL after
+    // a grace period. One that still exits on its own has finished (its
+    // key.txt is written) and is recorded; the others leave no folder.
+    stats.interrupted_by = g_stop_signal;
+    if (tty) log << "\r\033[K";
+    log << "matrix: " << signal_name(stats.interrupted_by) << " received: stopping " << running.size()
+        << " running cases; " << (todo.size() - next) << " not started\n" << std::flush;
+    for (const auto& [pid, r] : running) ::kill(pid, SIGTERM);
+    const auto deadline = Clock::now() + std::chrono::seconds(3);
+    while (!running.empty()) {
+      int status = 0;
+      const pid_t pid = ::waitpid(-1, &status, WNOHANG);
+      if (pid > 0) {
+        auto it = running.find(pid);
+        if (it == running.end()) continue;
+        const Running r = it->second;
+        running.erase(it);
+        record(*r.c, status, std::chrono::duration<double>(Clock::now() - r.start).count(), false);
+        continue;
+      }
+      if (Clock::now() > deadline) {
+        for (auto it = running.begin(); it != running.end(); it = running.erase(it)) {
+          ::kill(it->first, SIGKILL);
+          ::waitpid(it->first, &status, 0);
+          unfinished(*it->second.c, "worker did not stop within 3 s of SIGTERM: killed");
+        }
+        break;
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    }
+    stats.unfinished += todo.size() - next;
   }
   stats.seconds = elapsed();
   if (tty) log << "\r\033[K" << progress_line() << "\n";

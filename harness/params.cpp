@@ -26,7 +26,10 @@ Params Params::resolve(const std::vector<ParamSpec>& specs,
                        const std::string& method_name) {
   Params p;
   for (const auto& s : specs) p.values_.emplace_back(s.name, s.default_value);
-  for (const auto& [name, text] : given) {
+  for (const auto& given_pair : given) {
+    // Plain references: clang < 16 cannot capture structured bindings.
+    const std::string& name = given_pair.first;
+    const std::string& text = given_pair.second;
     auto it = std::find_if(specs.begin(), specs.end(),
                            [&](const ParamSpec& s) { return s.name == name; });
     if (it == specs.end()) {

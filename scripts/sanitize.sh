@@ -1,0 +1,22 @@
+#!/usr/bin/env bash
+# Builds the `sanitize` preset (ASan + UBSan, build/sanitize) and runs the
+# whole test suite under it; any sanitizer report aborts the test that hit it.
+# Extra arguments go to ctest (e.g. -LE slow). JOBS (default: nproc) sets
+# the build and test parallelism.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+JOBS="${JOBS:-$(nproc)}"
+start=$(date +%s)
+cmake --preset sanitize >/dev/null
+cmake --build build/sanitize -j"$JOBS"
+built=$(date +%s)
+# halt_on_error: the first finding fails the test (UBSan is recoverable by
+# default). detect_leaks: LeakSanitizer runs with ASan. The forked matrix
+# workers inherit the options.
+export ASAN_OPTIONS="halt_on_error=1:abort_on_error=1:detect_leaks=1:strict_string_checks=1:detect_stack_use_after_return=1${ASAN_OPTIONS:+:$ASAN_OPTIONS}"
+export UBSAN_OPTIONS="halt_on_error=1:abort_on_error=1:print_stacktrace=1${UBSAN_OPTIONS:+:$UBSAN_OPTIONS}"
+status=0
+(cd build/sanitize && ctest --output-on-failure -j"$JOBS" --timeout 1800 "$@") || status=$?
+end=$(date +%s)
+echo "sanitize: build $((built - start)) s, tests $((end - built)) s, exit $status"
+exit $status
