@@ -78,6 +78,11 @@ class Recorder {
       max_now = std::max(max_now, r);
     }
     result_.final_residual = max_now;
+    if (first_) result_.initial_residual = max_now;
+    if (!(max_now <= result_.recovery_threshold))
+      result_.recovery_time = std::numeric_limits<double>::quiet_NaN();
+    else if (std::isnan(result_.recovery_time))
+      result_.recovery_time = t;
     result_.max_residual = std::max(result_.max_residual, max_now);
     double energy_drift = 0;
     if (result_.has_energy) {
@@ -151,6 +156,10 @@ void check_positive_finite(double v, const std::string& flag) {
 
 }  // namespace
 
+void perturb_initial_state(double delta, int n, double* y) {
+  for (int i = 0; i < n; ++i) y[i] += delta * std::sin(double(i + 1));
+}
+
 double significant_digits(const std::vector<double>& y, const std::vector<double>& ref) {
   double worst = 0;
   for (size_t i = 0; i < y.size() && i < ref.size(); ++i)
@@ -179,6 +188,8 @@ RunResult run_case(const Problem& problem, const RunConfig& cfg, const std::stri
     throw UsageError("--sample-every: must be a finite number >= 0");
   if (!(cfg.blowup > 0)) throw UsageError("--blowup: must be > 0");
   if (cfg.observe_every < 1) throw UsageError("--observe-every: must be >= 1");
+  if (!std::isfinite(cfg.perturb) || cfg.perturb < 0) throw UsageError("--perturb: must be a finite number >= 0");
+  if (!(cfg.recovery_threshold > 0)) throw UsageError("--recovery-threshold: must be > 0");
   const std::string why = problem.why_not(cfg.method);
   if (!why.empty()) throw UsageError("--method " + cfg.method + ": " + why);
   const auto specs = problem.method_params(cfg.method, cfg.formulation);
@@ -193,6 +204,13 @@ RunResult run_case(const Problem& problem, const RunConfig& cfg, const std::stri
   if (!is_dae && integ_info.solves_dae)
     throw UsageError("--integrator " + cfg.integrator + ": solves DAEs F(t, y, y') = 0, but method '" +
                      cfg.method + "' is an ODE formulation; use a DAE method (ida-index1, ida-ggl)");
+  if (cfg.perturb > 0 && is_dae)
+    throw UsageError("--perturb: method '" + cfg.method +
+                     "' makes its initial values consistent before it starts (a DAE solver needs them), "
+                     "so it cannot start off the manifold");
+  if (cfg.perturb > 0 && form->formulation_name() == "minimal")
+    throw UsageError("--perturb: the minimal formulation satisfies the constraints by construction; "
+                     "there is no manifold to leave");
   auto integrator = make_integrator(cfg.integrator, cfg.step);
   form->set_step_hint(integ_info.fixed_step ? cfg.step.step : 0.0);
 
@@ -204,6 +222,8 @@ RunResult run_case(const Problem& problem, const RunConfig& cfg, const std::stri
   result.integrator = cfg.integrator;
   result.step = cfg.step;
   result.t_end = cfg.t_end;
+  result.perturb = cfg.perturb;
+  result.recovery_threshold = cfg.recovery_threshold;
   const auto& info = problem.info();
   double ref_time = cfg.ref_time < 0 ? info.reference_time : cfg.ref_time;
   if (ref_time > cfg.t_end || ref_time <= 0) ref_time = 0;
@@ -233,6 +253,7 @@ RunResult run_case(const Problem& problem, const RunConfig& cfg, const std::stri
   const int n = form->dimension();
   std::vector<double> y0(n), y_out(n);
   form->initial_state(y0.data());
+  if (cfg.perturb > 0) perturb_initial_state(cfg.perturb, n, y0.data());
   const double sample_every = cfg.sample_every > 0 ? cfg.sample_every : cfg.t_end / 1000;
   Recorder recorder(problem, *form, result, series.get(), sample_every);
 
@@ -303,6 +324,7 @@ RunResult run_case(const Problem& problem, const RunConfig& cfg, const std::stri
     if (target == cfg.t_end) result.final_state = recorder.canonical();
   }
   result.wall_seconds = std::max(0.0, seconds_since(start) - result.observe_seconds);
+  if (result.status != "ok") result.recovery_time = std::numeric_limits<double>::quiet_NaN();
   result.steps = integrator->steps();
   result.rejected_steps = integrator->rejected_steps();
   result.rhs_evals = integrator->rhs_evals();
@@ -347,6 +369,10 @@ std::vector<std::pair<std::string, std::string>> RunResult::summary_row() const 
   row.emplace_back("ref_time", num(ref_time));
   row.emplace_back("ref_error", num(ref_error));
   row.emplace_back("ref_scd", num(ref_scd));
+  row.emplace_back("perturb", format_short(perturb));
+  row.emplace_back("initial_residual", num(initial_residual));
+  row.emplace_back("recovery_time", num(recovery_time));
+  row.emplace_back("recovered", recovered() ? "yes" : "no");
   for (const auto& c : constraints) row.emplace_back("max_residual_" + c.name, format_exact(c.max_abs));
   for (const auto& c : constraints) row.emplace_back("final_residual_" + c.name, format_exact(c.final_abs));
   for (const auto& [name, v] : max_integral_drift) row.emplace_back("max_" + name + "_drift", format_exact(v));
