@@ -34,6 +34,9 @@ struct RunConfig {
   double perturb = 0;
   // Residual level a run must return to and stay below to count as recovered.
   double recovery_threshold = 1e-10;
+  // Long horizons: the growth exponent of the running max drift is fitted
+  // over t in [drift_fit_from, t_end] (when t_end >= 4 drift_fit_from).
+  double drift_fit_from = 10;
 };
 
 struct ConstraintMetrics {
@@ -72,6 +75,11 @@ struct RunResult {
   double initial_residual = std::numeric_limits<double>::quiet_NaN();
   double recovery_time = std::numeric_limits<double>::quiet_NaN();
   bool recovered() const { return status == "ok" && !std::isnan(recovery_time); }
+  // Slope p of log(max_{s<=t} |drift(s)|) against log(t), least squares over
+  // log-spaced t in [drift_fit_from, t_reached]: ~0 bounded, ~1/2 random
+  // walk, ~1 linear growth. NaN where not fitted.
+  double energy_drift_exponent = std::numeric_limits<double>::quiet_NaN();
+  std::vector<std::pair<std::string, double>> integral_drift_exponent;
 
   std::vector<std::pair<std::string, std::string>> summary_row() const;
 };
