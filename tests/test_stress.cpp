@@ -5,11 +5,13 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <fstream>
 #include <string>
 #include <vector>
 
 #include "harness/matrix.hpp"
 #include "harness/run.hpp"
+#include "harness/stress_report.hpp"
 #include "methods/dispatch.hpp"
 #include "problems/registry.hpp"
 #include "problems/wheel_sharp.hpp"
@@ -207,6 +209,58 @@ TEST(StressSharp, FormulationsAgreeAndEnergyIsConserved) {
   const RunResult mech = run(cfg);
   EXPECT_LT(mech.ref_error, 1e-5);
   EXPECT_LT(mech.max_energy_drift, 1e-8);
+}
+
+// The report's Stress section from a tiny matrix run by the binary: the
+// perturbed, long-horizon and stiffness cases land in their CSV files,
+// tables and pictures.
+TEST(StressReport, MatrixRunRendersTheStressSection) {
+  testing::Scratch s;
+  const std::string dir = s.dir().string();
+  {
+    std::ofstream f(dir + "/stress.toml");
+    f << "[defaults]\nproblems = [\"wheel\"]\nwork_precision = false\n"
+         "[[sweep]]\nname = \"perturb\"\nmethods = [\"none\", \"projection\"]\nintegrators = \"rk4\"\n"
+         "step = 1e-3\nt_end = 0.5\nperturb = [1e-4, 1e-3]\n"
+         "[[sweep]]\nname = \"long-test\"\nmethods = [\"projection\"]\nintegrators = \"rk4\"\nstep = 1e-2\n"
+         "t_end = 50\nsample_every = 0.5\n"
+         "[[sweep]]\nname = \"stiff-test\"\nmethods = [\"pesterev\"]\nintegrators = \"rk8pd\"\ntol = 1e-8\n"
+         "t_end = 1\nparam.lambda = [10, 100]\n";
+  }
+  const std::string cmd = std::string(CSTAB_BINARY) + " matrix " + dir + "/stress.toml --out " + dir +
+                          "/out --jobs 2 > " + dir + "/log.txt 2>&1";
+  ASSERT_EQ(testing::exit_code(std::system(cmd.c_str())), 0) << testing::slurp(dir + "/log.txt");
+  const CsvTable perturb = read_csv(dir + "/out/stress_perturb.csv");
+  ASSERT_EQ(perturb.rows.size(), 4u);
+  for (size_t r = 0; r < perturb.rows.size(); ++r) {
+    EXPECT_EQ(perturb.get(r, "recovered"), perturb.get(r, "method") == "projection" ? "yes" : "no");
+    EXPECT_GT(std::stod(perturb.get(r, "initial_residual")), 0.03 * std::stod(perturb.get(r, "perturb")));
+  }
+  const CsvTable lng = read_csv(dir + "/out/stress_long.csv");
+  ASSERT_EQ(lng.rows.size(), 1u);
+  EXPECT_TRUE(std::isfinite(std::stod(lng.get(0, "energy_drift_exponent"))));
+  EXPECT_FALSE(lng.get(0, "energy_growth").empty());
+  const CsvTable stiff = read_csv(dir + "/out/stress_stiff.csv");
+  ASSERT_EQ(stiff.rows.size(), 2u);
+  EXPECT_EQ(stiff.get(0, "gain"), "10");
+  EXPECT_EQ(stiff.get(1, "gain"), "100");
+  const std::string html = testing::slurp(dir + "/out/report.html");
+  EXPECT_NE(html.find("<h2 id=\"stress\">Stress</h2>"), std::string::npos);
+  EXPECT_NE(html.find("id=\"stress-perturb\""), std::string::npos);
+  EXPECT_NE(html.find("id=\"stress-long\""), std::string::npos);
+  EXPECT_NE(html.find("id=\"stress-stiff\""), std::string::npos);
+  if (std::system("command -v gnuplot > /dev/null 2>&1") == 0) {
+    for (const char* png : {"stress_perturb_wheel.png", "stress_long-test.png", "stress_stiff.png"})
+      EXPECT_TRUE(std::filesystem::exists(dir + "/out/plots/" + std::string(png))) << png;
+  }
+}
+
+TEST(StressGrowth, Classes) {
+  EXPECT_EQ(drift_growth_class(0.02), "bounded");
+  EXPECT_EQ(drift_growth_class(0.5), "~sqrt(t)");
+  EXPECT_EQ(drift_growth_class(1.0), "~linear");
+  EXPECT_EQ(drift_growth_class(2.0), "faster than linear");
+  EXPECT_EQ(drift_growth_class(std::nan("")), "");
 }
 
 }  // namespace
