@@ -23,7 +23,8 @@ usage:
   cstab run --problem P --method M [--formulation F] [--param name=value ...]
             --integrator I (--step H | --rtol R --atol A) --t-end T
             [--times t1,t2,...] [--sample-every DT] [--ref-time T]
-            [--blowup B] [--observe-every N] --out DIR
+            [--blowup B] [--observe-every N] [--perturb DELTA]
+            [--recovery-threshold R] [--drift-fit-from T] --out DIR
   cstab stability --problem P --method M --integrator I --gain-param NAME
             --steps h1,h2,... --gains g1,g2,... --t-end T --out DIR [--param k=v ...]
   cstab matrix [FILE] --out DIR [--jobs N] [--shard k/N] [--filter S] [--force]
@@ -99,7 +100,8 @@ int cmd_list(const std::vector<std::string>& argv) {
 int cmd_run(const std::vector<std::string>& argv) {
   Args args(argv,
             {"--problem", "--method", "--formulation", "--param", "--integrator", "--step", "--rtol", "--atol",
-             "--t-end", "--times", "--sample-every", "--ref-time", "--blowup", "--observe-every", "--out"},
+             "--t-end", "--times", "--sample-every", "--ref-time", "--blowup", "--observe-every", "--out",
+             "--perturb", "--recovery-threshold", "--drift-fit-from"},
             {"--no-series"}, {"--param", "--times"});
   if (!args.positional().empty()) throw UsageError("run: unexpected argument '" + args.positional()[0] + "'");
   RunConfig cfg;
@@ -130,6 +132,9 @@ int cmd_run(const std::vector<std::string>& argv) {
   cfg.blowup = args.number("--blowup", 1e3);
   cfg.observe_every = int(args.integer("--observe-every", 1));
   cfg.write_series = !args.has("--no-series");
+  cfg.perturb = args.number("--perturb", 0);
+  cfg.recovery_threshold = args.number("--recovery-threshold", 1e-10);
+  cfg.drift_fit_from = args.number("--drift-fit-from", 10);
   const std::string out = args.require("--out");
 
   const RunResult r = run_case(problem, cfg, out);

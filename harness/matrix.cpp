@@ -314,7 +314,7 @@ const std::vector<std::string>& known_keys() {
   static const std::vector<std::string> keys = {
       "name", "problems", "methods", "formulations", "integrators", "step", "tol", "rtol", "atol",
       "t_end", "ref_time", "times", "sample_every", "blowup", "observe_every", "series", "repeats",
-      "timeout", "repeat_if_under", "work_precision", "overlay", "optional"};
+      "timeout", "repeat_if_under", "work_precision", "overlay", "optional", "perturb"};
   return keys;
 }
 
@@ -488,6 +488,8 @@ std::string canonical_text(const RunConfig& c, int repeats, double timeout, doub
     << "\nobserve_every=" << c.observe_every << "\nseries=" << (c.write_series ? 1 : 0) << "\nrepeats=" << repeats
     << "\ntimeout=" << format_exact(timeout);
   if (repeat_if_under > 0) s << "\nrepeat_if_under=" << format_exact(repeat_if_under);
+  // Only when set, so that the ids of unperturbed cases stay what they were.
+  if (c.perturb > 0) s << "\nperturb=" << format_exact(c.perturb);
   s << "\n";
   return s.str();
 }
@@ -684,6 +686,13 @@ Expansion expand_matrix(const MatrixFile& file, const MatrixCatalog& catalog) {
       check("repeat_if_under", repeat_if_under >= 0, "must be >= 0 seconds (0: always repeat)");
     const int repeats = int(repeats_num);
     const bool series = set.boolean("series", true);
+    std::vector<double> perturbs;
+    for (const auto* v : set.list("perturb", Kind::kNumber)) {
+      if (!std::isfinite(v->number) || v->number < 0)
+        throw MatrixError(v->where, "perturb: must be a number >= 0 (0: consistent start)");
+      perturbs.push_back(v->number);
+    }
+    if (perturbs.empty()) perturbs.push_back(0);
     const bool work_precision = set.boolean("work_precision", true);
     const bool overlay = set.boolean("overlay", false);
 
@@ -815,7 +824,7 @@ Expansion expand_matrix(const MatrixFile& file, const MatrixCatalog& catalog) {
               // parameter combinations (odometer over the applying choices)
               std::vector<size_t> pick(applying.size(), 0);
               while (true) {
-                for (const StepSettings& st : settings) {
+                for (const StepSettings& st : settings) for (const double perturb : perturbs) {
                   // A typo like 10 arrays of 100 values must not eat the machine.
                   if (++combinations > kMaxCombinations || out.cases.size() >= kMaxCases)
                     throw MatrixError(sec.where, "the matrix expands to more than " + std::to_string(kMaxCases) +
@@ -838,6 +847,7 @@ Expansion expand_matrix(const MatrixFile& file, const MatrixCatalog& catalog) {
                   cfg.blowup = blowup;
                   cfg.observe_every = int(observe_every);
                   cfg.write_series = series;
+                  cfg.perturb = perturb;
                   c.timeout = timeout;
                   c.repeat_if_under = repeat_if_under;
                   c.config_text = canonical_text(cfg, repeats, timeout, repeat_if_under);
@@ -860,6 +870,7 @@ Expansion expand_matrix(const MatrixFile& file, const MatrixCatalog& catalog) {
                     e.setting = "tol=" + format_short(st.rtol);
                   else
                     e.setting = "rtol=" + format_short(st.rtol) + ";atol=" + format_short(st.atol);
+                  if (perturb > 0) e.setting += ";perturb=" + format_short(perturb);
                   e.t_end = t_end;
                   e.repeats = repeats;
                   e.work_precision = work_precision;
