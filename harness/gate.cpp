@@ -547,6 +547,7 @@ GateOutcome evaluate_gate(const ThresholdsFile& file, const std::string& dir) {
           value = r.median_wall / base.median_wall;
       }
       c.value = std::isnan(value) ? "n/a" : fmt(value);
+      c.value_number = value;
       c.pass = !std::isnan(value) && (b.lower ? value >= bound : value <= bound);
       if (!std::isnan(value)) c.margin = margin_text(value, bound, b.lower);
       add(c);
@@ -589,7 +590,8 @@ std::string format_gate_table(const GateOutcome& outcome) {
 std::string gate_csv(const GateOutcome& outcome) {
   std::string s = "line,case,check,value,threshold,margin,result,note\n";
   for (const auto& c : outcome.checks)
-    s += std::to_string(c.line) + "," + csv_cell(c.case_label) + "," + c.check + "," + csv_cell(c.value) + "," +
+    s += std::to_string(c.line) + "," + csv_cell(c.case_label) + "," + c.check + "," +
+         csv_cell(std::isnan(c.value_number) ? c.value : format_exact(c.value_number)) + "," +
          csv_cell(c.threshold) + "," + csv_cell(c.margin) + "," + (c.pass ? "pass" : "fail") + "," +
          csv_cell(c.note) + "\n";
   return s;
@@ -597,12 +599,21 @@ std::string gate_csv(const GateOutcome& outcome) {
 
 namespace {
 
-// The bound a measured value implies: upper bounds value x factor (floored),
-// significant digits value - log10(factor), time ratios value x time_factor.
-double derived_bound(const BoundSpec& b, double value, double factor, double time_factor) {
-  if (b.lower) return std::max(0.0, value - std::log10(factor));
-  if (!b.value) return value * time_factor;
-  return std::max(value, kValueFloor) * factor;
+// The bound a measured value implies (GateFactors).
+double derived_bound(const BoundSpec& b, double value, const GateFactors& f) {
+  if (b.lower) return std::max(0.0, value - std::log10(f.value));
+  if (!b.value) return value * f.time_ratio;
+  if (b.bound == &ThresholdRow::max_recovery_time) return value * f.recovery;
+  return std::max(value, kValueFloor) * f.value;
+}
+
+void check_factors(const GateFactors& f) {
+  auto check = [](double v, const char* flag) {
+    if (!(v >= 1) || !std::isfinite(v)) throw UsageError(std::string(flag) + ": must be a finite number >= 1");
+  };
+  check(f.value, "--factor");
+  check(f.time_ratio, "--time-factor");
+  check(f.recovery, "--recovery-factor");
 }
 
 void set_cell(ThresholdsFile& file, ThresholdRow& row, const std::string& column, const std::string& text) {
@@ -612,11 +623,9 @@ void set_cell(ThresholdsFile& file, ThresholdRow& row, const std::string& column
 
 }  // namespace
 
-std::vector<ThresholdChange> update_thresholds(ThresholdsFile& file, const std::string& dir, double factor,
-                                               double time_factor, std::vector<std::string>& notes) {
-  if (!(factor >= 1) || !std::isfinite(factor)) throw UsageError("--factor: must be a finite number >= 1");
-  if (!(time_factor >= 1) || !std::isfinite(time_factor))
-    throw UsageError("--time-factor: must be a finite number >= 1");
+std::vector<ThresholdChange> update_thresholds(ThresholdsFile& file, const std::string& dir,
+                                               const GateFactors& factors, std::vector<std::string>& notes) {
+  check_factors(factors);
   const std::vector<CaseEntry> entries = read_results_manifest(dir);
   std::vector<ThresholdChange> changes;
   std::vector<CaseResult> results(file.rows.size());
@@ -657,7 +666,7 @@ std::vector<ThresholdChange> update_thresholds(ThresholdsFile& file, const std::
                         " kept (no measured value)");
         continue;
       }
-      const std::string text = fmt_bound(derived_bound(b, value, factor, time_factor), b.lower);
+      const std::string text = fmt_bound(derived_bound(b, value, factors), b.lower);
       change(b.column, text);
       row.*(b.bound) = std::strtod(text.c_str(), nullptr);
     }
@@ -665,14 +674,15 @@ std::vector<ThresholdChange> update_thresholds(ThresholdsFile& file, const std::
   return changes;
 }
 
-ThresholdsFile initial_thresholds(const std::string& dir, double factor, const std::string& file_name) {
-  if (!(factor >= 1) || !std::isfinite(factor)) throw UsageError("--factor: must be a finite number >= 1");
+ThresholdsFile initial_thresholds(const std::string& dir, const GateFactors& factors, const std::string& file_name) {
+  check_factors(factors);
   const std::vector<CaseEntry> entries = read_results_manifest(dir);
   ThresholdsFile file;
   file.name = file_name;
   file.columns = kColumns;
   file.lines.push_back("# cstab gate thresholds, written by `cstab gate --init` from " + dir +
-                       " with safety factor " + format_short(factor) + " (docs/gate.md)");
+                       " with safety factors " + format_short(factors.value) + " (values), " +
+                       format_short(factors.recovery) + " (recovery times) (docs/gate.md)");
   std::string header;
   for (const auto& c : kColumns) header += (header.empty() ? "" : ",") + c;
   file.lines.push_back(header);
@@ -717,7 +727,10 @@ ThresholdsFile initial_thresholds(const std::string& dir, double factor, const s
         if (!b.value) continue;
         const double value = r.*(b.value);
         if (std::isnan(value)) continue;
-        const std::string text = fmt_bound(derived_bound(b, value, factor, 1), b.lower);
+        if (b.bound == &ThresholdRow::max_recovery_time && e.setting.find("perturb=") == std::string::npos)
+          continue;  // a consistent start has nothing to recover from
+        if (b.lower && value < 1) continue;  // not one correct digit: max_ref_error says it better
+        const std::string text = fmt_bound(derived_bound(b, value, factors), b.lower);
         set_cell(file, row, b.column, text);
         row.*(b.bound) = std::strtod(text.c_str(), nullptr);
       }

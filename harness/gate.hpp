@@ -70,7 +70,8 @@ struct GateCheck {
   std::string case_label;
   int line = 0;           // thresholds line
   std::string check;      // status | max_residual | ... | max_time_ratio
-  std::string value, threshold, margin;
+  std::string value, threshold, margin;  // as printed (3 significant digits)
+  double value_number = std::numeric_limits<double>::quiet_NaN();  // exact, for gate_csv
   bool pass = false;
   std::string note;       // why a check failed without a value (missing case, ...)
 };
@@ -91,16 +92,24 @@ struct ThresholdChange {
   std::string case_label, column, old_value, new_value;
 };
 
-// Re-baselines every bound that a row sets from `dir`'s measured values:
-// upper bounds become value x factor (values below 1e-15 count as 1e-15),
-// min_ref_scd becomes digits - log10(factor), max_time_ratio becomes
-// ratio x time_factor, status the measured status. Rows whose case is not in
-// `dir` are kept and named in `notes`.
-std::vector<ThresholdChange> update_thresholds(ThresholdsFile& file, const std::string& dir, double factor,
-                                               double time_factor, std::vector<std::string>& notes);
+// How far a re-baselined bound sits from the measured value.
+struct GateFactors {
+  double value = 10;        // upper bounds: value x this (values below 1e-15 count as 1e-15);
+                            // min_ref_scd: digits - log10(this)
+  double time_ratio = 3;    // max_time_ratio: ratio x this (timing noise)
+  double recovery = 1.5;    // max_recovery_time: time x this (deterministic; scales as 1/gain)
+};
+
+// Re-baselines every bound that a row sets from `dir`'s measured values
+// (see GateFactors) and status from the measured status. Rows whose case is
+// not in `dir` are kept and named in `notes`. Throws UsageError for factors
+// below 1.
+std::vector<ThresholdChange> update_thresholds(ThresholdsFile& file, const std::string& dir,
+                                               const GateFactors& factors, std::vector<std::string>& notes);
 
 // A new thresholds file with one row per completed case of `dir` and every
-// bound the case has a value for, set as update_thresholds would.
-ThresholdsFile initial_thresholds(const std::string& dir, double factor, const std::string& file_name);
+// bound the case has a value for (recovery time only for perturbed starts),
+// set as update_thresholds would.
+ThresholdsFile initial_thresholds(const std::string& dir, const GateFactors& factors, const std::string& file_name);
 
 }  // namespace cstab

@@ -332,6 +332,7 @@ TEST(GateMatrix, DegradedConfigurationsFailForTheRightReason) {
     std::string bad_method, bad_params, bad_setting;        // how it is degraded
     std::string failing_check;                              // the check that must fail
     std::string what;
+    std::string t_end = "\"ref\"";                          // matrix value
   };
   const std::vector<Degradation> degradations = {
       // Over the wheel's 5 s the unstabilized drift peaks only slightly above
@@ -348,13 +349,28 @@ TEST(GateMatrix, DegradedConfigurationsFailForTheRightReason) {
        "10x step"},
       {"biped", "baumgarte", "rk4", "step=0.001", "none", "", "step=0.001", "max_final_residual",
        "stabilization off: the inconsistent start is never corrected"},
+      // A stress case: from a start 1e-3 off the manifold, halved gains take
+      // about twice as long to bring the residual back below 1e-10.
+      {"wheel", "baumgarte", "rk8pd", "tol=1e-12;perturb=0.001", "baumgarte", "alpha=5;beta=5;gamma=5",
+       "tol=1e-12;perturb=0.001", "max_recovery_time", "gains halved", "3"},
       // (Not here: the slider crank with baumgarte gains 0 is *more* accurate
       // over its 1 s than with the default gains (residual 1.8e-13 vs 9.9e-13),
       // so no accuracy gate can or should flag it.)
   };
   std::string rows;
   std::set<int> emitted;
-  std::string matrix = "[defaults]\nt_end = \"ref\"\nseries = false\n";
+  std::string matrix = "[defaults]\nseries = false\n";
+  // "tol=1e-12;perturb=0.001" -> "tol = 1e-12\nperturb = 0.001\n" (matrix keys)
+  auto keys_of = [](const std::string& text) {
+    std::string out;
+    for (size_t start = 0; start < text.size();) {
+      const size_t end = std::min(text.find(';', start), text.size());
+      const std::string kv = text.substr(start, end - start);
+      out += kv.substr(0, kv.find('=')) + " = " + kv.substr(kv.find('=') + 1) + "\n";
+      start = end + 1;
+    }
+    return out;
+  };
   int sweep = 0;
   for (const auto& d : degradations) {
     const cstab::ThresholdRow* good = nullptr;
@@ -374,19 +390,18 @@ TEST(GateMatrix, DegradedConfigurationsFailForTheRightReason) {
       rows += "\n";
     }
     matrix += "[[sweep]]\nname = \"d" + std::to_string(sweep++) + "\"\nproblems = [\"" + d.problem +
-              "\"]\nmethods = [\"" + d.bad_method + "\"]\nintegrators = \"" + d.integrator + "\"\nstep = " +
-              d.bad_setting.substr(5) + "\n";
+              "\"]\nmethods = [\"" + d.bad_method + "\"]\nintegrators = \"" + d.integrator + "\"\nt_end = " +
+              d.t_end + "\n" + keys_of(d.bad_setting);
     std::string params = d.bad_params;
-    for (size_t pos; (pos = params.find(';')) != std::string::npos;) params[pos] = '\n';
-    for (size_t start = 0; start < params.size();) {
-      const size_t end = params.find('\n', start);
-      const std::string kv = params.substr(start, end - start);
-      matrix += "param." + kv.substr(0, kv.find('=')) + " = " + kv.substr(kv.find('=') + 1) + "\n";
-      start = end == std::string::npos ? params.size() : end + 1;
+    if (!params.empty()) {
+      params = keys_of(params);
+      for (size_t pos = 0; (pos = params.find('\n', pos)) != std::string::npos && pos + 1 < params.size(); ++pos)
+        params.insert(pos + 1, "param.");
+      matrix += "param." + params;
     }
     matrix += "[[sweep]]\nname = \"g" + std::to_string(sweep++) + "\"\nproblems = [\"" + d.problem +
-              "\"]\nmethods = [\"" + d.method + "\"]\nintegrators = \"" + d.integrator + "\"\nstep = " +
-              d.setting.substr(5) + "\n";
+              "\"]\nmethods = [\"" + d.method + "\"]\nintegrators = \"" + d.integrator + "\"\nt_end = " +
+              d.t_end + "\n" + keys_of(d.setting);
   }
   std::string header;
   for (size_t k = 0; k < committed.columns.size(); ++k) header += (k ? "," : "") + committed.columns[k];
