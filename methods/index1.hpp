@@ -40,7 +40,7 @@ class IndexOneFormulation : public MechanicalFormulationBase<Model> {
     VecQ a = mass_.solve(terms_.Q);
     if constexpr (nc > 0) {
       pinv_.set_rows(mass_, terms_.A);
-      a += pinv_.correction(-terms_.gamma - terms_.A * a);
+      a += pinv_.correction(-terms_.gamma - terms_.A.lazyProduct(a));
     }
     vmap<nq>(dydt) = v;
     vmap<nq>(dydt + nq) = a;
