@@ -19,6 +19,13 @@
 namespace cstab {
 
 namespace pesterev_detail {
+// min |U_ii| / max |U_ii| of a partial-pivoting LU (0 if singular).
+template <class Lu>
+double lu_pivot_ratio(const Lu& lu) {
+  const auto d = lu.matrixLU().diagonal().cwiseAbs();
+  const double mx = d.maxCoeff();
+  return mx > 0 ? d.minCoeff() / mx : 0.0;
+}
 inline double binomial(int n, int k) {
   double r = 1;
   for (int i = 1; i <= k; ++i) r = r * (n - k + i) / i;
@@ -64,9 +71,11 @@ class PesterevFormulation final : public AffineFormulationBase<Model> {
     Vec<double, m> phi = jet_.top;
     for (int i = 0; i < m; ++i) phi(i) += jet_.lower.row(i).dot(gains_.row(i));
     lu_.compute(jet_.A);
-    const double rcond = lu_.rcond();
-    if (!(rcond > 1e-14)) {
-      this->failure_ = "reaction matrix A(X) singular (rcond " + std::to_string(rcond) + ") at t = " +
+    // Singularity check from the LU pivots (min |U_ii| / max |U_ii|): the
+    // 1-norm rcond estimate cost a third of this right-hand side (README, Speed).
+    const double ratio = pesterev_detail::lu_pivot_ratio(lu_);
+    if (!(ratio > 1e-14)) {
+      this->failure_ = "reaction matrix A(X) singular (LU pivot ratio " + std::to_string(ratio) + ") at t = " +
                  std::to_string(t);
       return false;
     }

@@ -111,7 +111,9 @@ class SchurSolver {
   Status factor(const Eigen::Matrix<double, NQ, NQ>& M, const MatCQ& A, double min_pivot_ratio) {
     if (!mass_.factor(M)) return Status::kMassNotPd;
     Ct_ = mass_.solve_lower_matrix(Eigen::Matrix<double, NQ, NC>(A.transpose()));
-    S_.noalias() = Ct_.transpose().lazyProduct(Ct_);
+    // S = C C^T, lower triangle only (SmallCholesky reads no more).
+    for (int j = 0; j < NC; ++j)
+      for (int i = j; i < NC; ++i) S_(i, j) = Ct_.col(i).dot(Ct_.col(j));
     if (!schur_.factor(S_) || !(schur_.pivot_ratio() > min_pivot_ratio)) return Status::kSingular;
     return Status::kOk;
   }
@@ -125,7 +127,8 @@ class SchurSolver {
     mass_.solve_upper_in_place(w);
     return w;
   }
-  const MatC& schur() const { return S_; }
+  // S (both triangles)
+  MatC schur() const { return S_.template selfadjointView<Eigen::Lower>(); }
   double pivot_ratio() const { return schur_.pivot_ratio(); }
 
  private:
