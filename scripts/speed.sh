@@ -23,7 +23,10 @@ mkdir -p "$OUT"
 
 echo "speed: stage 1 (sweep) into $OUT/sweep" >&2
 "$CSTAB" matrix matrices/speed.toml --out "$OUT/sweep" --jobs "$JOBS" --no-report >"$OUT/sweep.log"
-awk -v TARGET="$TARGET" -f scripts/speed-best.awk "$OUT"/sweep/cases/*/summary.csv | sort >"$OUT/stage1-best.csv"
+# Only the cases of this matrix (the folder may hold cases of earlier versions of it).
+ids=$(awk -F, 'NR == 1 { for (i = 1; i <= NF; i++) if ($i == "case_id") c = i; next } { print $c }' "$OUT/sweep/cases.csv")
+files=(); for id in $ids; do [[ -f "$OUT/sweep/cases/$id/summary.csv" ]] && files+=("$OUT/sweep/cases/$id/summary.csv"); done
+awk -v TARGET="$TARGET" -f scripts/speed-best.awk "${files[@]}" | sort >"$OUT/stage1-best.csv"
 
 # Stage 2: one sweep per chosen case, all its parameters spelled out.
 awk -F, -v R="$REPEATS" '
@@ -35,7 +38,8 @@ awk -F, -v R="$REPEATS" '
     printf "t_end = \"ref\"\nseries = false\nobserve_every = 100000000\nrepeats = %d\ntimeout = 120\n\n", R }
 ' "$OUT/stage1-best.csv" >"$OUT/retime.toml"
 echo "speed: stage 2 (re-timing $(wc -l <"$OUT/stage1-best.csv") cases, $REPEATS repeats, one at a time)" >&2
-"$CSTAB" matrix "$OUT/retime.toml" --out "$OUT/retime" --jobs 1 --force --no-report >"$OUT/retime.log"
+rm -rf "$OUT/retime"
+"$CSTAB" matrix "$OUT/retime.toml" --out "$OUT/retime" --jobs 1 --no-report >"$OUT/retime.log"
 awk -v TARGET="$TARGET" -f scripts/speed-best.awk "$OUT"/retime/cases/*/summary.csv | sort >"$OUT/stage2-best.csv"
 
 # Ratios within the stage-2 run.
