@@ -4,10 +4,12 @@
 // and the accelerations and multipliers come from the augmented (KKT) system
 //     [ M  A^T ] [ a      ]   [ Q                  ]
 //     [ A  0   ] [ lambda ] = [ -gamma_acc - stab  ]
-// which needs full-rank constraint rows.
+// which needs full-rank constraint rows; it is solved through its Schur
+// complement (A M^-1 A^T) lambda = -(A M^-1 Q + gamma_acc + stab).
 #pragma once
 
 #include "methods/mechanical_method.hpp"
+#include "methods/small_linalg.hpp"
 
 namespace cstab {
 
@@ -20,7 +22,6 @@ class BaumgarteFormulation final : public MechanicalFormulationBase<Model> {
   using Base::nh;
   using Base::nq;
   using typename Base::VecQ;
-  static constexpr int nk = nq + nc;
 
   BaumgarteFormulation(const Model& model, double alpha, double beta, double gamma)
       : Base(model), alpha_(alpha), beta_(beta), gamma_(gamma) {}
@@ -28,36 +29,41 @@ class BaumgarteFormulation final : public MechanicalFormulationBase<Model> {
   bool rhs(double t, const double* y, double* dydt) override {
     const VecQ q = vmap<nq>(y), v = vmap<nq>(y + nq);
     terms_.evaluate(this->model_, t, q, v, false);
-    K_.setZero();
-    K_.template topLeftCorner<nq, nq>() = terms_.M;
-    rhs_.template head<nq>() = terms_.Q;
-    if constexpr (nc > 0) {
-      K_.template topRightCorner<nq, nc>() = terms_.A.transpose();
-      K_.template bottomLeftCorner<nc, nq>() = terms_.A;
-      Vec<double, nc> stab;
-      if constexpr (nh > 0)
-        stab.template head<nh>() = 2 * alpha_ * terms_.velocity.template head<nh>() + beta_ * beta_ * terms_.phi;
-      if constexpr (nc > nh)
-        stab.template tail<nc - nh>() = gamma_ * terms_.velocity.template tail<nc - nh>();
-      rhs_.template tail<nc>() = -terms_.gamma - stab;
-    }
-    lu_.compute(K_);
-    if (!(lu_.rcond() > 1e-15)) {
-      this->failure_ = "KKT matrix singular (rcond " + std::to_string(lu_.rcond()) + ") at t = " + std::to_string(t);
-      return false;
-    }
-    sol_ = lu_.solve(rhs_);
     vmap<nq>(dydt) = v;
-    vmap<nq>(dydt + nq) = sol_.template head<nq>();
+    if constexpr (nc == 0) {
+      if (!mass_.factor(terms_.M)) return mass_failure(t);
+      vmap<nq>(dydt + nq) = mass_.solve(terms_.Q);
+    } else {
+      const auto status = solver_.factor(terms_.M, terms_.A, 1e-15);
+      if (status == SchurSolver<nq, nc>::Status::kMassNotPd) return mass_failure(t);
+      if (status != SchurSolver<nq, nc>::Status::kOk) {
+        this->failure_ = "constraint matrix A M^-1 A^T singular (pivot ratio " +
+                         std::to_string(solver_.pivot_ratio()) + ") at t = " + std::to_string(t);
+        return false;
+      }
+      const VecQ a = solver_.free_acceleration(terms_.Q);
+      Vec<double, nc> rows = terms_.A.lazyProduct(a) + terms_.gamma;  // A a + gamma + stab = 0
+      if constexpr (nh > 0)
+        rows.template head<nh>() += 2 * alpha_ * terms_.velocity.template head<nh>() + beta_ * beta_ * terms_.phi;
+      if constexpr (nc > nh)
+        rows.template tail<nc - nh>() += gamma_ * terms_.velocity.template tail<nc - nh>();
+      vmap<nq>(dydt + nq) = a + solver_.reaction_acceleration(solver_.multipliers(-rows));
+    }
     return true;
   }
 
  private:
+  bool mass_failure(double t) {
+    this->failure_ = "mass matrix not positive definite at t = " + std::to_string(t);
+    return false;
+  }
+
   double alpha_, beta_, gamma_;
   MechanicalTerms<Model> terms_;
-  Eigen::Matrix<double, nk, nk> K_;
-  Vec<double, nk> rhs_, sol_;
-  Eigen::PartialPivLU<Eigen::Matrix<double, nk, nk>> lu_;
+  // The KKT system [M A^T; A 0] [a; N] = [Q; -gamma - stab], solved by its
+  // Schur complement A M^-1 A^T (M positive definite, A full rank).
+  SchurSolver<nq, (nc > 0 ? nc : 1)> solver_;
+  SmallCholesky<nq> mass_;  // no constraint rows
 };
 
 struct BaumgarteMethod : MechanicalMethod<BaumgarteMethod> {

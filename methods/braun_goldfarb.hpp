@@ -67,7 +67,7 @@ class BraunGoldfarbFormulation final : public MechanicalFormulationBase<Model> {
     VecQ w = VecQ::Zero();
     if constexpr (nc > 0) {
       pinv_v_.set_rows(mass_, terms_.A);
-      w = pinv_v_.pinv(-terms_.gamma - terms_.A * a - inv_dt * terms_.velocity);
+      w = pinv_v_.pinv(-terms_.gamma - terms_.A.lazyProduct(a) - inv_dt * terms_.velocity);
       vdot += mass_.r_inverse(w);
     }
     if constexpr (Model::kHasEnergy) {
@@ -85,7 +85,7 @@ class BraunGoldfarbFormulation final : public MechanicalFormulationBase<Model> {
   VecQ energy_correction(const VecQ& a, const VecQ& w, double inv_dt) {
     const VecQ ce = mass_.rt_inverse(terms_.energy_grad_v);  // C_e^T
     VecQ u = ce;                                              // (C_e N_v)^T = N_v C_e^T
-    if constexpr (nc > 0) u -= pinv_v_.pinv(pinv_v_.C() * ce);
+    if constexpr (nc > 0) u -= pinv_v_.pinv(pinv_v_.C().lazyProduct(ce));
     const double uu = u.squaredNorm();
     if (!(uu > tol_)) return VecQ::Zero();
     const double rhs = -terms_.energy_rate_free - terms_.energy_grad_v.dot(a) -

@@ -12,6 +12,7 @@
 #include <cmath>
 
 #include "methods/mechanical_method.hpp"
+#include "methods/small_linalg.hpp"
 #include "methods/weighted_pinv.hpp"
 
 namespace cstab {
@@ -26,6 +27,7 @@ class IndexOneFormulation : public MechanicalFormulationBase<Model> {
   using Base::nn;
   using Base::nq;
   using typename Base::VecQ;
+  using VecC = Vec<double, nc>;
 
   IndexOneFormulation(const Model& model, bool project, double tol, int max_iter)
       : Base(model), project_(project), tol_(tol), max_iter_(max_iter) {}
@@ -33,14 +35,25 @@ class IndexOneFormulation : public MechanicalFormulationBase<Model> {
   bool rhs(double t, const double* y, double* dydt) override {
     const VecQ q = vmap<nq>(y), v = vmap<nq>(y + nq);
     terms_.evaluate(this->model_, t, q, v, false);
-    if (!mass_.factor(terms_.M)) {
-      this->failure_ = "mass matrix not positive definite at t = " + std::to_string(t);
-      return false;
-    }
-    VecQ a = mass_.solve(terms_.Q);
+    VecQ a;
     if constexpr (nc > 0) {
-      pinv_.set_rows(mass_, terms_.A);
-      a += pinv_.correction(-terms_.gamma - terms_.A * a);
+      // Full-rank rows (the usual case): C^+ = C^T (C C^T)^-1, i.e. the Schur
+      // complement A M^-1 A^T by Cholesky; redundant (or nearly redundant)
+      // rows fall back to the complete orthogonal decomposition.
+      const auto status = schur_.factor(terms_.M, terms_.A, 1e-10);
+      if (status == SchurSolver<nq, nc>::Status::kMassNotPd) return mass_failure(t);
+      a = schur_.free_acceleration(terms_.Q);
+      const VecC r = -terms_.gamma - terms_.A.lazyProduct(a);
+      if (status == SchurSolver<nq, nc>::Status::kOk) {
+        a += schur_.reaction_acceleration(schur_.multipliers(r));
+      } else {
+        if (!mass_.factor(terms_.M)) return mass_failure(t);
+        pinv_.set_rows(mass_, terms_.A);
+        a += pinv_.correction(r);
+      }
+    } else {
+      if (!mass_.factor(terms_.M)) return mass_failure(t);
+      a = mass_.solve(terms_.Q);
     }
     vmap<nq>(dydt) = v;
     vmap<nq>(dydt + nq) = a;
@@ -76,12 +89,18 @@ class IndexOneFormulation : public MechanicalFormulationBase<Model> {
   }
 
  private:
+  bool mass_failure(double t) {
+    this->failure_ = "mass matrix not positive definite at t = " + std::to_string(t);
+    return false;
+  }
+
   bool project_;
   double tol_;
   int max_iter_;
   MechanicalTerms<Model> terms_, pos_terms_, vel_terms_;
   Eigen::Matrix<double, nq, nq> M_;
   MassFactor<nq> mass_, post_mass_;
+  SchurSolver<nq, (nc > 0 ? nc : 1)> schur_;
   WeightedPinv<nc, nq> pinv_, vel_pinv_;
   WeightedPinv<(nh > 0 ? nh : 1), nq> pos_pinv_;
 };

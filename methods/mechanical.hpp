@@ -75,7 +75,7 @@ struct MechanicalTerms {
   // Velocity rows only: A and the velocity residual (affine in v).
   void evaluate_velocity(const Model& model, double t, const VecQ& q, const VecQ& v) {
     evaluate_position(model, t, q);
-    if constexpr (nh > 0) velocity.template head<nh>() = A.template topRows<nh>() * v + phi_t;
+    if constexpr (nh > 0) velocity.template head<nh>() = A.template topRows<nh>().lazyProduct(v) + phi_t;
     if constexpr (nn > 0) nonholonomic_terms(model, t, q, v);
   }
 

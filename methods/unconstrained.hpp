@@ -5,6 +5,7 @@
 
 #include "methods/affine.hpp"
 #include "methods/mechanical.hpp"
+#include "methods/small_linalg.hpp"
 
 namespace cstab {
 
@@ -21,16 +22,17 @@ class UnconstrainedMechanical final : public MechanicalFormulationBase<Model> {
     const VecQ q = vmap<nq>(y), v = vmap<nq>(y + nq);
     this->model_.mass(t, q, M_);
     this->model_.forces(t, q, v, Q_);
-    llt_.compute(M_);
+    if (!mass_.factor(M_)) return false;
     vmap<nq>(dydt) = v;
-    vmap<nq>(dydt + nq) = llt_.solve(Q_);
+    vmap<nq>(dydt + nq) = mass_.solve(Q_);
     return true;
   }
 
  private:
   Eigen::Matrix<double, nq, nq> M_;
   VecQ Q_;
-  Eigen::LLT<Eigen::Matrix<double, nq, nq>> llt_;
+  SmallCholesky<nq> mass_;  // the same factorization code as the methods'
+
 };
 
 template <class Model>

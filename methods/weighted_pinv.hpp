@@ -8,6 +8,8 @@
 
 #include <Eigen/Dense>
 
+#include "methods/small_linalg.hpp"
+
 namespace cstab {
 
 template <int N>
@@ -16,23 +18,20 @@ class MassFactor {
   using VecN = Eigen::Matrix<double, N, 1>;
 
   // Returns false if M is not positive definite.
-  bool factor(const Eigen::Matrix<double, N, N>& M) {
-    llt_.compute(M);
-    return llt_.info() == Eigen::Success;
-  }
-  VecN solve(const VecN& b) const { return llt_.solve(b); }
-  // R^-1 w
-  VecN r_inverse(const VecN& w) const { return llt_.matrixU().solve(w); }
+  bool factor(const Eigen::Matrix<double, N, N>& M) { return chol_.factor(M); }
+  VecN solve(const VecN& b) const { return chol_.solve(b); }
+  // R^-1 w (R = L^T)
+  VecN r_inverse(const VecN& w) const { return chol_.solve_upper(w); }
   // R^-T a = L^-1 a (a row a^T times R^-1, as a column)
-  VecN rt_inverse(const VecN& a) const { return llt_.matrixL().solve(a); }
-  // R^-T B, evaluated (no expression outlives its operands)
+  VecN rt_inverse(const VecN& a) const { return chol_.solve_lower(a); }
+  // R^-T B
   template <int K>
   Eigen::Matrix<double, N, K> rt_inverse_matrix(const Eigen::Matrix<double, N, K>& B) const {
-    return llt_.matrixL().solve(B);
+    return chol_.solve_lower_matrix(B);
   }
 
  private:
-  Eigen::LLT<Eigen::Matrix<double, N, N>> llt_;
+  SmallCholesky<N> chol_;
 };
 
 template <int K, int N>
