@@ -142,7 +142,9 @@ std::vector<Case> all_cases() {
 StepSettings settings_for(const Problem& p, const IntegratorInfo& info) {
   StepSettings s;
   const double horizon = p.info().reference_time > 0 ? p.info().reference_time : 1.0;
-  if (info.fixed_step) s.step = horizon / 2000;
+  // 1/20000 of the horizon: wheel-sharp's minimal ODE (1 - r kappa = 0.03 near
+  // the sharp point) diverges with adams at 1/5000 of it.
+  if (info.fixed_step) s.step = horizon / 20000;
   else s.rtol = s.atol = 1e-8;
   return s;
 }
