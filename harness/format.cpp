@@ -22,4 +22,11 @@ std::string format_short(double v) {
   return std::string(buf, res.ptr);
 }
 
+std::string format_3g(double v) {
+  if (std::isnan(v)) return "";
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.3g", v);
+  return buf;
+}
+
 }  // namespace cstab

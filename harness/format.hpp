@@ -9,5 +9,7 @@ namespace cstab {
 std::string format_exact(double v);
 // Shortest form that reads back to the same double, for labels and keys.
 std::string format_short(double v);
+// Three significant digits ("%.3g"), for tables people read; "" for NaN.
+std::string format_3g(double v);
 
 }  // namespace cstab

@@ -124,12 +124,7 @@ double parse_number(const std::string& text, const std::string& at, const std::s
   return v;
 }
 
-std::string fmt(double v) {
-  if (std::isnan(v)) return "";
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.3g", v);
-  return buf;
-}
+std::string fmt(double v) { return format_3g(v); }
 
 // A bound written with 3 significant digits, rounded outwards so that the
 // value it was derived from still passes (upper: >= v, lower: <= v).

@@ -36,12 +36,7 @@ std::string esc(const std::string& s) {
   return out;
 }
 
-std::string sci(double v) {
-  if (std::isnan(v)) return "";
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.3g", v);
-  return buf;
-}
+std::string sci(double v) { return format_3g(v); }
 
 std::string line(const std::vector<std::string>& cells) {
   std::string s;
