@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 #include <fstream>
 #include <map>
 #include <numeric>
@@ -294,6 +295,8 @@ MatrixFile parse_matrix(const std::string& text, const std::string& file_name) {
 }
 
 MatrixFile read_matrix_file(const std::string& path) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) throw UsageError(path + ": is a folder, not a matrix file");
   std::string text;
   try {
     text = read_text_file(path);
@@ -529,6 +532,7 @@ Expansion expand_matrix(const MatrixFile& file, const MatrixCatalog& catalog) {
       if (!seen_names.insert(name).second) throw MatrixError(v->where, "name: '" + name + "' used by another sweep");
     }
     auto note = [&](const std::string& text) { out.notes.push_back("sweep '" + name + "': " + text); };
+    const size_t notes_before = out.notes.size();
 
     // ---- problems ----
     bool every_problem = false;
@@ -730,7 +734,8 @@ Expansion expand_matrix(const MatrixFile& file, const MatrixCatalog& catalog) {
     }
 
     // ---- the product ----
-    size_t not_applicable = 0;
+    size_t not_applicable = 0, wrong_integrator = 0;
+    const size_t cases_before = out.cases.size(), duplicates_before = duplicates;
     for (const Problem* problem : problems) {
       const ProblemInfo& info = problem->info();
       for (const MethodInfo* method : methods) {
@@ -749,6 +754,14 @@ Expansion expand_matrix(const MatrixFile& file, const MatrixCatalog& catalog) {
         } catch (const UsageError& e) {
           note(method->name + " on " + info.name + ": " + e.what());
           continue;
+        }
+        // A DAE formulation F(t, y, y') = 0 needs a DAE integrator and an
+        // ODE one an ODE integrator: impossible pairs are not cases.
+        int is_dae = -1;  // -1: unknown (the formulation cannot be built with defaults)
+        try {
+          const auto f = problem->make(method->name, "", Params::resolve(specs, {}, method->name));
+          if (f) is_dae = dynamic_cast<const DaeSystem*>(f.get()) != nullptr;
+        } catch (const UsageError&) {
         }
         std::vector<ParamChoice*> applying;
         for (auto& pc : param_choices) {
@@ -788,10 +801,18 @@ Expansion expand_matrix(const MatrixFile& file, const MatrixCatalog& catalog) {
             }
           }
           for (const IntegratorInfo* integ : integrators) {
+            if (is_dae >= 0 && bool(is_dae) != integ->solves_dae) {
+              ++wrong_integrator;
+              continue;
+            }
             for (const TEnd& te : t_ends) {
               double t_end = te.value;
               if (te.mode == "ref") t_end = info.reference_time > 0 ? info.reference_time : info.default_t_end;
               if (te.mode == "default") t_end = info.default_t_end;
+              if (ref_time > t_end)
+                throw MatrixError(set.find("ref_time")->value.where,
+                                  "ref_time: " + set.find("ref_time")->value.text + " is beyond t_end " +
+                                      format_short(t_end) + " (problem '" + info.name + "')");
               for (const auto* v : times)
                 if (v->number > t_end)
                   throw MatrixError(v->where, "times: " + v->text + " is beyond t_end " + format_short(t_end) +
@@ -882,10 +903,20 @@ Expansion expand_matrix(const MatrixFile& file, const MatrixCatalog& catalog) {
       if (!pc.used && !optional)
         note("param." + (pc.method.empty() ? "" : pc.method + ".") + pc.name + " (line " +
              std::to_string(pc.where.line) + ") applies to no method of the sweep");
+    if (wrong_integrator)
+      note(std::to_string(wrong_integrator) + " method x integrator combinations skipped: DAE methods (ida-*) need "
+           "integrator 'ida', and 'ida' needs a DAE method");
+    if (out.cases.size() == cases_before && duplicates == duplicates_before && !optional) {
+      std::string why;
+      for (size_t i = notes_before; i < out.notes.size(); ++i) why += "; " + out.notes[i];
+      throw MatrixError(sec.where, "sweep '" + name + "' expands to no case" +
+                                       (why.empty() ? std::string() : why));
+    }
     if (not_applicable && (every_method || every_problem))
       note(std::to_string(not_applicable) + " problem x method combinations do not apply (see `cstab list`)");
   }
   if (duplicates) out.notes.push_back(std::to_string(duplicates) + " duplicate cases dropped (same configuration)");
+  if (sweep_number == 0) throw MatrixError({file.name, 1, 1}, "no [[sweep]] table: nothing to run");
   return out;
 }
 
