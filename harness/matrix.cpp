@@ -506,7 +506,7 @@ std::string CaseEntry::label() const {
 }
 
 // Limits on one matrix (the default one has under 1000 cases).
-constexpr size_t kMaxCases = 100000, kMaxCombinations = 1000000;
+constexpr size_t kMaxCases = 100000;
 
 Expansion expand_matrix(const MatrixFile& file, const MatrixCatalog& catalog) {
   Expansion out;
@@ -516,7 +516,8 @@ Expansion expand_matrix(const MatrixFile& file, const MatrixCatalog& catalog) {
     if (sec.kind == "defaults") defaults = &sec;
   }
   std::set<std::string> seen_ids, seen_names;
-  size_t duplicates = 0, combinations = 0;
+  size_t duplicates = 0;
+  double planned = 0;  // upper bound of the cases so far
   int sweep_number = 0;
   for (const auto& sec : file.sections) {
     if (sec.kind != "sweep") continue;
@@ -791,6 +792,15 @@ Expansion expand_matrix(const MatrixFile& file, const MatrixCatalog& catalog) {
         std::vector<std::string> forms;
         for (const auto* f : formulations) forms.push_back(f->text);
         if (forms.empty()) forms.push_back("");
+        // An upper bound of what this pair adds, checked before anything is
+        // built: a typo like four arrays of 100 values must not eat the machine.
+        double planned_here = double(forms.size()) * double(integrators.size()) * double(t_ends.size()) *
+                              double(std::max({steps.size(), tols.size(), rtols.size() * atols.size(), size_t(1)}));
+        for (const ParamChoice* pc : applying) planned_here *= double(pc->values.size());
+        planned += planned_here;
+        if (planned > double(kMaxCases))
+          throw MatrixError(sec.where, "the matrix expands to more than " + std::to_string(kMaxCases) +
+                                           " cases: split it into several files");
         for (const std::string& form : forms) {
           if (!form.empty()) {
             try {
@@ -837,11 +847,6 @@ Expansion expand_matrix(const MatrixFile& file, const MatrixCatalog& catalog) {
               std::vector<size_t> pick(applying.size(), 0);
               while (true) {
                 for (const StepSettings& st : settings) {
-                  // A typo like 10 arrays of 100 values must not eat the machine.
-                  if (++combinations > kMaxCombinations || out.cases.size() >= kMaxCases)
-                    throw MatrixError(sec.where, "the matrix expands to more than " + std::to_string(kMaxCases) +
-                                                     " cases (or " + std::to_string(kMaxCombinations) +
-                                                     " combinations): split it into several files");
                   MatrixCase c;
                   RunConfig& cfg = c.config;
                   cfg.problem = info.name;
