@@ -316,8 +316,6 @@ TEST(Cli, UnwritableOutUnderARegularFile) {
 
 // An existing folder that cannot take files, with --no-series: the folder
 // must be found unwritable before the run (exit 2), not after it.
-// DISABLED: fails today (exit 1 after the whole integration), see the fix
-// proposed for harness/run.cpp (probe the summary file before integrating).
 TEST(Cli, UnwritableOutWithoutSeries) {
   Scratch s;
   auto args = kGood;
