@@ -242,6 +242,8 @@ class Parser {
     const double x = std::strtod(digits.c_str(), &end);
     const bool numeric_start = std::isdigit(static_cast<unsigned char>(digits[0])) || digits[0] == '+' ||
                                digits[0] == '-' || digits[0] == '.';
+    if (end == digits.c_str() + digits.size() && !std::isfinite(x))
+      throw MatrixError(v.where, "'" + token + "' is not a finite number");
     if (!numeric_start || end != digits.c_str() + digits.size())
       throw MatrixError(v.where, "'" + token + "' is not a number, true/false, array or string (strings are "
                                  "quoted: \"" + token + "\")");

@@ -94,6 +94,10 @@ TEST(MatrixExpand, RejectsImpossibleSettingsAtTheirLocation) {
       {head + "observe_every = 1e300\n", "m.toml:7:17: ", "observe_every"},  // was an int overflow
       {head + "repeats = 1.5\n", "m.toml:7:11: ", "repeats"},
       {head + "series = 1\n", "m.toml:7:10: ", "expected true/false"},
+      {head + "blowup = nan\n", "m.toml:7:10: ", "'nan' is not a finite number"},
+      {head + "timeout = inf\n", "m.toml:7:11: ", "'inf' is not a finite number"},
+      {head + "timeout = -inf\n", "m.toml:7:11: ", "'-inf' is not a finite number"},
+      {head + "timeout = 1e999\n", "m.toml:7:11: ", "'1e999' is not a finite number"},
       {"[[sweep]]\nproblems = [\"wheel\"]\nmethods = [\"ida-ggl\"]\nintegrators = \"rk4\"\nstep = 1e-3\n",
        "m.toml:1:1: ", "expands to no case"},
       {"[[sweep]]\nproblems = [\"wheel\"]\nmethods = [\"pesterev\"]\nintegrators = \"ida\"\ntol = 1e-6\n",
