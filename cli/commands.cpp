@@ -4,6 +4,7 @@
 #include <sstream>
 
 #include "cli/args.hpp"
+#include "cli/gate_command.hpp"
 #include "cli/stability_command.hpp"
 #include "cli/matrix_commands.hpp"
 #include "harness/format.hpp"
@@ -22,7 +23,8 @@ usage:
   cstab run --problem P --method M [--formulation F] [--param name=value ...]
             --integrator I (--step H | --rtol R --atol A) --t-end T
             [--times t1,t2,...] [--sample-every DT] [--ref-time T]
-            [--blowup B] [--observe-every N] --out DIR
+            [--blowup B] [--observe-every N] [--perturb DELTA]
+            [--recovery-threshold R] [--drift-fit-from T] --out DIR
   cstab stability --problem P --method M --integrator I --gain-param NAME
             --steps h1,h2,... --gains g1,g2,... --t-end T --out DIR [--param k=v ...]
   cstab matrix [FILE] --out DIR [--jobs N] [--shard k/N] [--filter S] [--force]
@@ -30,6 +32,11 @@ usage:
                runs a benchmark matrix (default: the embedded one; docs/matrix.md)
   cstab merge OUT SHARD_DIR... [--jobs N] [--no-report]
   cstab report DIR [--jobs N] [--no-plots]
+  cstab gate [--thresholds FILE] [--csv OUT] DIR
+               checks a matrix results folder against accuracy thresholds (docs/gate.md);
+               exit 1 if any check fails
+  cstab gate --update [--factor F] [--time-factor T] [--thresholds FILE] DIR
+  cstab gate --init FILE [--factor F] DIR
 
 Exit codes: 0 success (a diverged run is a recorded result), 2 bad input, 1 internal error.
 See README.md for every column of summary.csv and series.csv.
@@ -93,7 +100,8 @@ int cmd_list(const std::vector<std::string>& argv) {
 int cmd_run(const std::vector<std::string>& argv) {
   Args args(argv,
             {"--problem", "--method", "--formulation", "--param", "--integrator", "--step", "--rtol", "--atol",
-             "--t-end", "--times", "--sample-every", "--ref-time", "--blowup", "--observe-every", "--out"},
+             "--t-end", "--times", "--sample-every", "--ref-time", "--blowup", "--observe-every", "--out",
+             "--perturb", "--recovery-threshold", "--drift-fit-from"},
             {"--no-series"}, {"--param", "--times"});
   if (!args.positional().empty()) throw UsageError("run: unexpected argument '" + args.positional()[0] + "'");
   RunConfig cfg;
@@ -128,6 +136,9 @@ int cmd_run(const std::vector<std::string>& argv) {
   if (observe_every < 1 || observe_every > 1000000000) throw UsageError("--observe-every: must be in [1, 1e9]");
   cfg.observe_every = int(observe_every);
   cfg.write_series = !args.has("--no-series");
+  cfg.perturb = args.number("--perturb", 0);
+  cfg.recovery_threshold = args.number("--recovery-threshold", 1e-10);
+  cfg.drift_fit_from = args.number("--drift-fit-from", 10);
   const std::string out = args.require("--out");
 
   const RunResult r = run_case(problem, cfg, out);
@@ -150,7 +161,8 @@ int dispatch(const std::string& command, const std::vector<std::string>& args) {
   if (command == "matrix") return cmd_matrix(args);
   if (command == "merge") return cmd_merge(args);
   if (command == "report") return cmd_report(args);
-  throw UsageError("unknown command '" + command + "' (known: list, run, stability, matrix, merge, report)");
+  if (command == "gate") return cmd_gate(args);
+  throw UsageError("unknown command '" + command + "' (known: list, run, stability, matrix, merge, report, gate)");
 }
 
 }  // namespace cstab::cli

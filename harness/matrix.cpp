@@ -319,7 +319,7 @@ const std::vector<std::string>& known_keys() {
   static const std::vector<std::string> keys = {
       "name", "problems", "methods", "formulations", "integrators", "step", "tol", "rtol", "atol",
       "t_end", "ref_time", "times", "sample_every", "blowup", "observe_every", "series", "repeats",
-      "timeout", "repeat_if_under", "work_precision", "overlay", "optional"};
+      "timeout", "repeat_if_under", "work_precision", "overlay", "optional", "perturb"};
   return keys;
 }
 
@@ -493,6 +493,8 @@ std::string canonical_text(const RunConfig& c, int repeats, double timeout, doub
     << "\nobserve_every=" << c.observe_every << "\nseries=" << (c.write_series ? 1 : 0) << "\nrepeats=" << repeats
     << "\ntimeout=" << format_exact(timeout);
   if (repeat_if_under > 0) s << "\nrepeat_if_under=" << format_exact(repeat_if_under);
+  // Only when set, so that the ids of unperturbed cases stay what they were.
+  if (c.perturb > 0) s << "\nperturb=" << format_exact(c.perturb);
   s << "\n";
   return s.str();
 }
@@ -691,6 +693,13 @@ Expansion expand_matrix(const MatrixFile& file, const MatrixCatalog& catalog) {
       check("repeat_if_under", repeat_if_under >= 0, "must be >= 0 seconds (0: always repeat)");
     const int repeats = int(repeats_num);
     const bool series = set.boolean("series", true);
+    std::vector<double> perturbs;
+    for (const auto* v : set.list("perturb", Kind::kNumber)) {
+      if (!std::isfinite(v->number) || v->number < 0)
+        throw MatrixError(v->where, "perturb: must be a number >= 0 (0: consistent start)");
+      perturbs.push_back(v->number);
+    }
+    if (perturbs.empty()) perturbs.push_back(0);
     const bool work_precision = set.boolean("work_precision", true);
     const bool overlay = set.boolean("overlay", false);
 
@@ -798,6 +807,7 @@ Expansion expand_matrix(const MatrixFile& file, const MatrixCatalog& catalog) {
         // built: a typo like four arrays of 100 values must not eat the machine.
         double planned_here = double(forms.size()) * double(integrators.size()) * double(t_ends.size()) *
                               double(std::max({steps.size(), tols.size(), rtols.size() * atols.size(), size_t(1)}));
+        planned_here *= double(perturbs.size());
         for (const ParamChoice* pc : applying) planned_here *= double(pc->values.size());
         planned += planned_here;
         if (planned > double(kMaxCases))
@@ -848,7 +858,7 @@ Expansion expand_matrix(const MatrixFile& file, const MatrixCatalog& catalog) {
               // parameter combinations (odometer over the applying choices)
               std::vector<size_t> pick(applying.size(), 0);
               while (true) {
-                for (const StepSettings& st : settings) {
+                for (const StepSettings& st : settings) for (const double perturb : perturbs) {
                   MatrixCase c;
                   RunConfig& cfg = c.config;
                   cfg.problem = info.name;
@@ -866,6 +876,7 @@ Expansion expand_matrix(const MatrixFile& file, const MatrixCatalog& catalog) {
                   cfg.blowup = blowup;
                   cfg.observe_every = int(observe_every);
                   cfg.write_series = series;
+                  cfg.perturb = perturb;
                   c.timeout = timeout;
                   c.repeat_if_under = repeat_if_under;
                   c.config_text = canonical_text(cfg, repeats, timeout, repeat_if_under);
@@ -888,6 +899,7 @@ Expansion expand_matrix(const MatrixFile& file, const MatrixCatalog& catalog) {
                     e.setting = "tol=" + format_short(st.rtol);
                   else
                     e.setting = "rtol=" + format_short(st.rtol) + ";atol=" + format_short(st.atol);
+                  if (perturb > 0) e.setting += ";perturb=" + format_short(perturb);
                   e.t_end = t_end;
                   e.repeats = repeats;
                   e.work_precision = work_precision;

@@ -19,6 +19,7 @@
 #include "format.hpp"
 #include "matrix.hpp"
 #include "provenance.hpp"
+#include "stress_report.hpp"
 
 #ifndef CSTAB_SOURCE_ROOT
 #define CSTAB_SOURCE_ROOT ""
@@ -691,6 +692,18 @@ ReportResult build_report(const std::string& dir, const ReportOptions& opt, std:
     }
   }
 
+  // The Stress section (stress_report.hpp): its tables and pictures.
+  const StressSection stress = build_stress_section(dir, entries, summary);
+  std::vector<std::string> stress_plots;
+  for (const StressPlot& sp : stress.plots) {
+    const std::string data_path = plot_dir + "/data/" + sp.name + ".dat";
+    write_file_atomic(data_path, sp.data);
+    jobs.push_back({sp.name, sp.script, "data=" + gp_string(data_path) + "; out=" + gp_string(plot_dir + "/" + sp.name) + sp.vars,
+                    sp.data, sp.caption});
+    captions[sp.name] = sp.caption;
+    stress_plots.push_back(sp.name);
+  }
+
   // replot.sh: the exact commands, for editing a picture by hand.
   const std::string scripts = opt.plot_scripts.empty() ? find_plot_scripts() : opt.plot_scripts;
   {
@@ -761,6 +774,7 @@ ReportResult build_report(const std::string& dir, const ReportOptions& opt, std:
     << ". Wall times are integration only (observation excluded), median over the repeats.</p>\n";
   h << "<nav>";
   for (const auto& p : problems) h << "<a href=\"#problem-" << html(p.name) << "\">" << html(p.name) << "</a>";
+  if (!stress.empty) h << "<a href=\"#stress\">stress</a>";
   h << "<a href=\"#cases\">all cases</a><a href=\"#provenance\">provenance</a></nav>\n";
 
   // Overview.
@@ -860,6 +874,18 @@ ReportResult build_report(const std::string& dir, const ReportOptions& opt, std:
         << ".png</code>, <code>plots/" << html(name) << ".svg</code>.</figcaption></figure>\n";
     }
     if (p.plots.empty()) h << "<p>No finished runs to plot.</p>\n";
+  }
+
+  // Stress tests.
+  if (!stress.empty) {
+    h << "<h2 id=\"stress\">Stress</h2>\n" << stress.html;
+    for (const auto& name : stress_plots) {
+      const std::string png = file_or_empty(plot_dir + "/" + name + ".png");
+      if (png.empty()) continue;
+      h << "<figure><img alt=\"" << html(name) << "\" src=\"data:image/png;base64," << base64(png)
+        << "\"><figcaption>" << html(captions[name]) << " Files: <code>plots/" << html(name)
+        << ".png</code>, <code>plots/" << html(name) << ".svg</code>.</figcaption></figure>\n";
+    }
   }
 
   // All cases.

@@ -22,9 +22,20 @@ double seconds_since(Clock::time_point start) {
 class Recorder {
  public:
   Recorder(const Problem& problem, Formulation& form, RunResult& result, AtomicFile* series,
-           double sample_every)
+           double sample_every, double fit_from, double t_end)
       : problem_(problem), form_(form), result_(result), series_(series),
         sample_every_(sample_every) {
+    // Checkpoints of the running max drift for the growth fit (energy, then
+    // each first integral), allocated here, filled during the run.
+    if (fit_from > 0 && t_end >= 4 * fit_from) {
+      fit_from_ = fit_from;
+      fit_ratio_ = std::pow(t_end / fit_from, 1.0 / (kCheckpoints - 1));
+      next_checkpoint_ = fit_from;
+      const size_t quantities = 1 + problem.info().first_integrals.size();
+      checkpoint_t_.reserve(kCheckpoints);
+      checkpoint_max_.assign(quantities, {});
+      for (auto& v : checkpoint_max_) v.reserve(kCheckpoints);
+    }
     const auto& info = problem.info();
     const auto& cons = form.constraints();
     canonical_.assign(info.coordinates.size(), 0);
@@ -78,6 +89,11 @@ class Recorder {
       max_now = std::max(max_now, r);
     }
     result_.final_residual = max_now;
+    if (first_) result_.initial_residual = max_now;
+    if (!(max_now <= result_.recovery_threshold))
+      result_.recovery_time = std::numeric_limits<double>::quiet_NaN();
+    else if (std::isnan(result_.recovery_time))
+      result_.recovery_time = t;
     result_.max_residual = std::max(result_.max_residual, max_now);
     double energy_drift = 0;
     if (result_.has_energy) {
@@ -96,6 +112,12 @@ class Recorder {
     }
     first_ = false;
     result_.t_reached = t;
+    if (fit_from_ > 0 && t >= next_checkpoint_ && checkpoint_t_.size() < kCheckpoints) {
+      checkpoint_t_.push_back(t);
+      checkpoint_max_[0].push_back(result_.has_energy ? result_.max_energy_drift : 0.0);
+      for (size_t i = 0; i < integrals_.size(); ++i) checkpoint_max_[i + 1].push_back(result_.max_integral_drift[i].second);
+      while (next_checkpoint_ <= t) next_checkpoint_ *= fit_ratio_;
+    }
     if (series_ && (series_row || t >= next_sample_)) {
       if (t >= next_sample_)
         next_sample_ = sample_every_ * (std::floor(t / sample_every_ + 1e-9) + 1);
@@ -127,6 +149,29 @@ class Recorder {
     return true;
   }
 
+  // Growth exponents from the checkpoints (after the run).
+ public:
+  void fit_drift_growth() {
+    auto slope = [&](const std::vector<double>& m) {
+      double n = 0, sx = 0, sy = 0, sxx = 0, sxy = 0;
+      for (size_t k = 0; k < checkpoint_t_.size(); ++k) {
+        if (!(m[k] > 0) || !std::isfinite(m[k])) continue;
+        const double x = std::log(checkpoint_t_[k]), y = std::log(m[k]);
+        n += 1, sx += x, sy += y, sxx += x * x, sxy += x * y;
+      }
+      const double den = n * sxx - sx * sx;
+      return n >= 5 && den > 0 ? (n * sxy - sx * sy) / den : std::numeric_limits<double>::quiet_NaN();
+    };
+    const bool fitted = !checkpoint_t_.empty();
+    if (result_.has_energy && fitted) result_.energy_drift_exponent = slope(checkpoint_max_[0]);
+    for (size_t i = 0; i < integrals_.size(); ++i)
+      result_.integral_drift_exponent.emplace_back(
+          problem_.info().first_integrals[i],
+          fitted ? slope(checkpoint_max_[i + 1]) : std::numeric_limits<double>::quiet_NaN());
+  }
+
+ private:
+
   void append(double v) {
     line_ += ',';
     line_ += format_exact(v);
@@ -142,6 +187,10 @@ class Recorder {
   double energy0_ = 0;
   std::vector<double> canonical_, residuals_, integrals_, integrals0_;
   std::string line_;
+  static constexpr size_t kCheckpoints = 40;
+  double fit_from_ = 0, fit_ratio_ = 1, next_checkpoint_ = 0;
+  std::vector<double> checkpoint_t_;
+  std::vector<std::vector<double>> checkpoint_max_;
 };
 
 void check_positive_finite(double v, const std::string& flag) {
@@ -150,6 +199,10 @@ void check_positive_finite(double v, const std::string& flag) {
 }
 
 }  // namespace
+
+void perturb_initial_state(double delta, int n, double* y) {
+  for (int i = 0; i < n; ++i) y[i] += delta * std::sin(double(i + 1));
+}
 
 double significant_digits(const std::vector<double>& y, const std::vector<double>& ref) {
   double worst = 0;
@@ -179,6 +232,10 @@ RunResult run_case(const Problem& problem, const RunConfig& cfg, const std::stri
     throw UsageError("--sample-every: must be a finite number >= 0");
   if (!(cfg.blowup > 0)) throw UsageError("--blowup: must be > 0");
   if (cfg.observe_every < 1) throw UsageError("--observe-every: must be >= 1");
+  if (!std::isfinite(cfg.perturb) || cfg.perturb < 0) throw UsageError("--perturb: must be a finite number >= 0");
+  if (!std::isfinite(cfg.drift_fit_from) || cfg.drift_fit_from < 0)
+    throw UsageError("--drift-fit-from: must be a finite number >= 0 (0: no fit)");
+  if (!(cfg.recovery_threshold > 0)) throw UsageError("--recovery-threshold: must be > 0");
   const std::string why = problem.why_not(cfg.method);
   if (!why.empty()) throw UsageError("--method " + cfg.method + ": " + why);
   const auto specs = problem.method_params(cfg.method, cfg.formulation);
@@ -193,6 +250,13 @@ RunResult run_case(const Problem& problem, const RunConfig& cfg, const std::stri
   if (!is_dae && integ_info.solves_dae)
     throw UsageError("--integrator " + cfg.integrator + ": solves DAEs F(t, y, y') = 0, but method '" +
                      cfg.method + "' is an ODE formulation; use a DAE method (ida-index1, ida-ggl)");
+  if (cfg.perturb > 0 && is_dae)
+    throw UsageError("--perturb: method '" + cfg.method +
+                     "' makes its initial values consistent before it starts (a DAE solver needs them), "
+                     "so it cannot start off the manifold");
+  if (cfg.perturb > 0 && form->formulation_name() == "minimal")
+    throw UsageError("--perturb: the minimal formulation satisfies the constraints by construction; "
+                     "there is no manifold to leave");
   auto integrator = make_integrator(cfg.integrator, cfg.step);
   form->set_step_hint(integ_info.fixed_step ? cfg.step.step : 0.0);
 
@@ -204,6 +268,8 @@ RunResult run_case(const Problem& problem, const RunConfig& cfg, const std::stri
   result.integrator = cfg.integrator;
   result.step = cfg.step;
   result.t_end = cfg.t_end;
+  result.perturb = cfg.perturb;
+  result.recovery_threshold = cfg.recovery_threshold;
   const auto& info = problem.info();
   double ref_time = cfg.ref_time < 0 ? info.reference_time : cfg.ref_time;
   if (ref_time > cfg.t_end || ref_time <= 0) ref_time = 0;
@@ -233,8 +299,9 @@ RunResult run_case(const Problem& problem, const RunConfig& cfg, const std::stri
   const int n = form->dimension();
   std::vector<double> y0(n), y_out(n);
   form->initial_state(y0.data());
+  if (cfg.perturb > 0) perturb_initial_state(cfg.perturb, n, y0.data());
   const double sample_every = cfg.sample_every > 0 ? cfg.sample_every : cfg.t_end / 1000;
-  Recorder recorder(problem, *form, result, series.get(), sample_every);
+  Recorder recorder(problem, *form, result, series.get(), sample_every, cfg.drift_fit_from, cfg.t_end);
 
   std::vector<double> targets = cfg.times;
   if (ref_time > 0) targets.push_back(ref_time);
@@ -303,6 +370,8 @@ RunResult run_case(const Problem& problem, const RunConfig& cfg, const std::stri
     if (target == cfg.t_end) result.final_state = recorder.canonical();
   }
   result.wall_seconds = std::max(0.0, seconds_since(start) - result.observe_seconds);
+  if (result.status != "ok") result.recovery_time = std::numeric_limits<double>::quiet_NaN();
+  recorder.fit_drift_growth();
   result.steps = integrator->steps();
   result.rejected_steps = integrator->rejected_steps();
   result.rhs_evals = integrator->rhs_evals();
@@ -347,9 +416,15 @@ std::vector<std::pair<std::string, std::string>> RunResult::summary_row() const 
   row.emplace_back("ref_time", num(ref_time));
   row.emplace_back("ref_error", num(ref_error));
   row.emplace_back("ref_scd", num(ref_scd));
+  row.emplace_back("perturb", format_short(perturb));
+  row.emplace_back("initial_residual", num(initial_residual));
+  row.emplace_back("recovery_time", num(recovery_time));
+  row.emplace_back("recovered", recovered() ? "yes" : "no");
+  row.emplace_back("energy_drift_exponent", has_energy ? num(energy_drift_exponent) : "");
   for (const auto& c : constraints) row.emplace_back("max_residual_" + c.name, format_exact(c.max_abs));
   for (const auto& c : constraints) row.emplace_back("final_residual_" + c.name, format_exact(c.final_abs));
   for (const auto& [name, v] : max_integral_drift) row.emplace_back("max_" + name + "_drift", format_exact(v));
+  for (const auto& [name, v] : integral_drift_exponent) row.emplace_back(name + "_drift_exponent", num(v));
   for (const auto& kv : extra) row.push_back(kv);
   return row;
 }

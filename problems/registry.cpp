@@ -12,6 +12,7 @@ std::unique_ptr<Problem> make_biped_problem();
 std::unique_ptr<Problem> make_slider_crank_problem();
 std::unique_ptr<Problem> make_andrews_problem();
 std::unique_ptr<Problem> make_car_axis_problem();
+std::unique_ptr<Problem> make_wheel_sharp_problem();
 
 const std::vector<std::unique_ptr<Problem>>& all_problems() {
   static const std::vector<std::unique_ptr<Problem>> list = [] {
@@ -22,6 +23,7 @@ const std::vector<std::unique_ptr<Problem>>& all_problems() {
     v.push_back(make_slider_crank_problem());
     v.push_back(make_andrews_problem());
     v.push_back(make_car_axis_problem());
+    v.push_back(make_wheel_sharp_problem());
     return v;
   }();
   return list;

@@ -228,8 +228,13 @@ class WheelMechanical {
       const double g = (s - xv) + (p_.p(s) - zv) * p_.dp(s);
       double dg = 1 + p_.dp(s) * p_.dp(s) + (p_.p(s) - zv) * p_.ddp(s);
       // Far from the foot the distance may be locally concave: fall back to
-      // a gradient step scaled by the Gauss-Newton term.
-      if (dg < 0.1) dg = 1 + p_.dp(s) * p_.dp(s);
+      // a gradient step scaled by the Gauss-Newton term. At the foot
+      // dg = w^2 (1 - r kappa) > 0, which is small where the curvature
+      // nears 1/r (wheel-sharp): there the full Newton step is the right
+      // one (a fallback threshold of 0.1 made the iteration crawl and stop
+      // 50 iterations short of the foot).
+      const double gauss_newton = 1 + p_.dp(s) * p_.dp(s);
+      if (dg < 1e-3 * gauss_newton) dg = gauss_newton;
       const double ds = g / dg;
       s -= ds;
       if (std::abs(ds) < 1e-15) break;

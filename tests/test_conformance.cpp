@@ -41,7 +41,10 @@ RunConfig config_for(const std::string& problem, const std::string& method, doub
     // RK4 as in the paper; dt = 10 h (with dt = h the stiff correction
     // leaves an O(h^2) residual floor, see the README).
     cfg.integrator = "rk4";
-    cfg.step.step = std::min(1e-3, t_end / 2000);
+    // wheel-sharp (near-singular by design, README "Stress"): its contact
+    // point runs 1/sigma ~ 33 times faster than the centre, and h = 1e-3
+    // does not resolve that (0.45 off at t = 5, measured); 2e-4 does.
+    cfg.step.step = std::min(problem == "wheel-sharp" ? 2e-4 : 1e-3, t_end / 2000);
     cfg.params = {{"dt", std::to_string(10 * cfg.step.step)}};
   } else {
     cfg.integrator = "rk8pd";
