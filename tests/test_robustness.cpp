@@ -265,6 +265,13 @@ TEST(Determinism, TwoRunsWriteIdenticalSeries) {
   }
 }
 
+// In a forked child before exec: the default actions for the signals the
+// tests send (a background job of a non-interactive shell inherits SIGINT
+// ignored, and cstab rightly keeps it so).
+void default_signals() {
+  for (int sig : {SIGINT, SIGTERM, SIGHUP}) ::signal(sig, SIG_DFL);
+}
+
 // ---------------------------------------------------------------------------
 // An interrupted `cstab run` leaves neither a half-written file nor a
 // temporary: it dies of the signal with an empty output folder.
@@ -276,6 +283,7 @@ TEST(Interrupt, RunLeavesNoFileBehind) {
     const fs::path out = s.dir() / "out";
     const pid_t pid = ::fork();
     if (pid == 0) {
+      default_signals();
       const int fd = ::open("/dev/null", O_WRONLY);
       ::dup2(fd, 1);
       ::dup2(fd, 2);
@@ -375,6 +383,7 @@ class MatrixInterrupt : public ::testing::Test {
     const pid_t pid = ::fork();
     if (pid == 0) {
       ::setpgid(0, 0);
+      default_signals();
       const int fd = ::open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
       ::dup2(fd, 1);
       ::dup2(fd, 2);
