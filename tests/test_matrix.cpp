@@ -369,15 +369,15 @@ TEST_F(MatrixRun, SingleRunWritesResultsPlotsAndReport) {
 TEST_F(MatrixRun, UnchangedRerunRunsNothing) {
   ASSERT_EQ(single_.code, 0) << single_.text;
   const std::string before = slurp(dir_ + "/single/summary.csv");
-  const auto start = std::chrono::steady_clock::now();
   const Output again = sh(std::string(CSTAB_BINARY) + " matrix " + dir_ + "/tiny.toml --out " + dir_ + "/single");
-  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   ASSERT_EQ(again.code, 0) << again.text;
   EXPECT_NE(again.text.find("10 of 10 cases cached"), std::string::npos) << again.text;
   EXPECT_NE(again.text.find("0 run, 10 cached"), std::string::npos) << again.text;
   EXPECT_NE(again.text.find("0 plots drawn"), std::string::npos) << again.text;
   EXPECT_EQ(slurp(dir_ + "/single/summary.csv"), before);  // nothing rerun: even the timings are the same
-  EXPECT_LT(seconds, 5.0);
+  // No wall-time bound here (a timed test fails under the sanitizers and on a
+  // loaded machine): "0 run", "0 plots drawn" and the unchanged summary say
+  // that nothing was redone.
 }
 
 TEST_F(MatrixRun, TwoShardsThroughGnuParallelMergeToTheSingleRun) {
