@@ -129,8 +129,12 @@ int cmd_run(const std::vector<std::string>& argv) {
   cfg.times = args.number_list("--times");
   cfg.sample_every = args.number("--sample-every", 0);
   cfg.ref_time = args.number("--ref-time", -1);
+  if (args.has("--ref-time") && !(cfg.ref_time >= 0 && cfg.ref_time <= cfg.t_end))
+    throw UsageError("--ref-time: must be in [0, t_end] (0: no reference error)");
   cfg.blowup = args.number("--blowup", 1e3);
-  cfg.observe_every = int(args.integer("--observe-every", 1));
+  const long observe_every = args.integer("--observe-every", 1);
+  if (observe_every < 1 || observe_every > 1000000000) throw UsageError("--observe-every: must be in [1, 1e9]");
+  cfg.observe_every = int(observe_every);
   cfg.write_series = !args.has("--no-series");
   cfg.perturb = args.number("--perturb", 0);
   cfg.recovery_threshold = args.number("--recovery-threshold", 1e-10);

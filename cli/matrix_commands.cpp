@@ -159,6 +159,9 @@ int cmd_matrix(const std::vector<std::string>& argv) {
   if (args.has("--shard")) std::tie(shard_k, shard_n) = parse_shard(args.require("--shard"));
   const std::string filter = args.get("--filter");
   const auto filtered = select_cases(expansion.cases, filter, 1, 1);
+  if (!filter.empty() && filtered.empty())
+    throw UsageError("--filter '" + filter + "': matches none of the " + std::to_string(expansion.cases.size()) +
+                     " cases (see --list)");
   const auto cases = select_cases(filtered, "", shard_k, shard_n);
 
   if (args.has("--list")) {
@@ -247,8 +250,9 @@ int cmd_merge(const std::vector<std::string>& argv) {
   const auto& pos = args.positional();
   if (pos.size() < 2) throw UsageError("usage: cstab merge OUT SHARD_DIR... (at least one shard folder)");
   const std::vector<std::string> shards(pos.begin() + 1, pos.end());
+  const int jobs = jobs_flag(args);  // before anything is written
   const size_t missing = merge_results(pos[0], shards, std::cout);
-  if (!args.has("--no-report")) finish(pos[0], jobs_flag(args), true);
+  if (!args.has("--no-report")) finish(pos[0], jobs, true);
   if (missing) {
     std::cerr << "cstab merge: " << missing << " cases of the matrix are missing from the shards (exit code 3)\n";
     return 3;
@@ -260,9 +264,10 @@ int cmd_report(const std::vector<std::string>& argv) {
   Args args(argv, {"--jobs"}, {"--no-plots"});
   if (args.positional().size() != 1) throw UsageError("usage: cstab report DIR [--jobs N] [--no-plots]");
   const std::string dir = args.positional()[0];
+  const int jobs = jobs_flag(args);
   const std::vector<CaseEntry> entries = read_results_manifest(dir);
   write_matrix_summary(dir, entries);
-  finish(dir, jobs_flag(args), !args.has("--no-plots"));
+  finish(dir, jobs, !args.has("--no-plots"));
   return 0;
 }
 

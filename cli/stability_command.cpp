@@ -43,6 +43,7 @@ int cmd_stability(const std::vector<std::string>& argv) {
   cfg.steps = args.number_list("--steps");
   cfg.gains = args.number_list("--gains");
   if (cfg.steps.empty()) throw UsageError("--steps: required (comma-separated)");
+  if (cfg.gains.empty()) throw UsageError("--gains: required (comma-separated)");
   for (double h : cfg.steps)
     if (!(h > 0)) throw UsageError("--steps: " + format_short(h) + " must be > 0");
   for (double g : cfg.gains)
@@ -51,8 +52,10 @@ int cmd_stability(const std::vector<std::string>& argv) {
   if (!(cfg.base.t_end > 0)) throw UsageError("--t-end: must be > 0");
   cfg.base.blowup = args.number("--blowup", 1.0);
   if (!(cfg.base.blowup > 0)) throw UsageError("--blowup: must be > 0");
-  cfg.bisection_iterations = int(args.integer("--bisect", 10));
-  if (cfg.bisection_iterations < 0) throw UsageError("--bisect: must be >= 0");
+  const long bisect = args.integer("--bisect", 10);
+  // 60 halvings take any bracket below double resolution.
+  if (bisect < 0 || bisect > 60) throw UsageError("--bisect: must be in [0, 60]");
+  cfg.bisection_iterations = int(bisect);
   const std::string out = args.require("--out");
 
   // Validate the combination (method, gain parameter) with one cheap run

@@ -26,7 +26,13 @@ class AtomicFile {
   std::string path_, temp_path_;
   std::FILE* file_ = nullptr;
   bool committed_ = false;
+  int slot_ = -1;  // in the table remove_temporary_files() reads
 };
+
+// Removes the temporary files of every AtomicFile alive in this process.
+// Async-signal-safe (unlink only): for a SIGINT/SIGTERM handler, so an
+// interrupted command leaves neither a half-written file nor a temporary.
+void remove_temporary_files();
 
 // Quote a CSV field if it needs it (RFC 4180).
 std::string csv_field(const std::string& s);

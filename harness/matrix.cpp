@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 #include <fstream>
 #include <map>
 #include <numeric>
@@ -241,6 +242,8 @@ class Parser {
     const double x = std::strtod(digits.c_str(), &end);
     const bool numeric_start = std::isdigit(static_cast<unsigned char>(digits[0])) || digits[0] == '+' ||
                                digits[0] == '-' || digits[0] == '.';
+    if (end == digits.c_str() + digits.size() && !std::isfinite(x))
+      throw MatrixError(v.where, "'" + token + "' is not a finite number");
     if (!numeric_start || end != digits.c_str() + digits.size())
       throw MatrixError(v.where, "'" + token + "' is not a number, true/false, array or string (strings are "
                                  "quoted: \"" + token + "\")");
@@ -294,6 +297,8 @@ MatrixFile parse_matrix(const std::string& text, const std::string& file_name) {
 }
 
 MatrixFile read_matrix_file(const std::string& path) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) throw UsageError(path + ": is a folder, not a matrix file");
   std::string text;
   try {
     text = read_text_file(path);
@@ -505,7 +510,7 @@ std::string CaseEntry::label() const {
 }
 
 // Limits on one matrix (the default one has under 1000 cases).
-constexpr size_t kMaxCases = 100000, kMaxCombinations = 1000000;
+constexpr size_t kMaxCases = 100000;
 
 Expansion expand_matrix(const MatrixFile& file, const MatrixCatalog& catalog) {
   Expansion out;
@@ -515,7 +520,8 @@ Expansion expand_matrix(const MatrixFile& file, const MatrixCatalog& catalog) {
     if (sec.kind == "defaults") defaults = &sec;
   }
   std::set<std::string> seen_ids, seen_names;
-  size_t duplicates = 0, combinations = 0;
+  size_t duplicates = 0;
+  double planned = 0;  // upper bound of the cases so far
   int sweep_number = 0;
   for (const auto& sec : file.sections) {
     if (sec.kind != "sweep") continue;
@@ -531,6 +537,7 @@ Expansion expand_matrix(const MatrixFile& file, const MatrixCatalog& catalog) {
       if (!seen_names.insert(name).second) throw MatrixError(v->where, "name: '" + name + "' used by another sweep");
     }
     auto note = [&](const std::string& text) { out.notes.push_back("sweep '" + name + "': " + text); };
+    const size_t notes_before = out.notes.size();
 
     // ---- problems ----
     bool every_problem = false;
@@ -739,7 +746,8 @@ Expansion expand_matrix(const MatrixFile& file, const MatrixCatalog& catalog) {
     }
 
     // ---- the product ----
-    size_t not_applicable = 0;
+    size_t not_applicable = 0, wrong_integrator = 0;
+    const size_t cases_before = out.cases.size(), duplicates_before = duplicates;
     for (const Problem* problem : problems) {
       const ProblemInfo& info = problem->info();
       for (const MethodInfo* method : methods) {
@@ -758,6 +766,14 @@ Expansion expand_matrix(const MatrixFile& file, const MatrixCatalog& catalog) {
         } catch (const UsageError& e) {
           note(method->name + " on " + info.name + ": " + e.what());
           continue;
+        }
+        // A DAE formulation F(t, y, y') = 0 needs a DAE integrator and an
+        // ODE one an ODE integrator: impossible pairs are not cases.
+        int is_dae = -1;  // -1: unknown (the formulation cannot be built with defaults)
+        try {
+          const auto f = problem->make(method->name, "", Params::resolve(specs, {}, method->name));
+          if (f) is_dae = dynamic_cast<const DaeSystem*>(f.get()) != nullptr;
+        } catch (const UsageError&) {
         }
         std::vector<ParamChoice*> applying;
         for (auto& pc : param_choices) {
@@ -787,6 +803,16 @@ Expansion expand_matrix(const MatrixFile& file, const MatrixCatalog& catalog) {
         std::vector<std::string> forms;
         for (const auto* f : formulations) forms.push_back(f->text);
         if (forms.empty()) forms.push_back("");
+        // An upper bound of what this pair adds, checked before anything is
+        // built: a typo like four arrays of 100 values must not eat the machine.
+        double planned_here = double(forms.size()) * double(integrators.size()) * double(t_ends.size()) *
+                              double(std::max({steps.size(), tols.size(), rtols.size() * atols.size(), size_t(1)}));
+        planned_here *= double(perturbs.size());
+        for (const ParamChoice* pc : applying) planned_here *= double(pc->values.size());
+        planned += planned_here;
+        if (planned > double(kMaxCases))
+          throw MatrixError(sec.where, "the matrix expands to more than " + std::to_string(kMaxCases) +
+                                           " cases: split it into several files");
         for (const std::string& form : forms) {
           if (!form.empty()) {
             try {
@@ -797,10 +823,18 @@ Expansion expand_matrix(const MatrixFile& file, const MatrixCatalog& catalog) {
             }
           }
           for (const IntegratorInfo* integ : integrators) {
+            if (is_dae >= 0 && bool(is_dae) != integ->solves_dae) {
+              ++wrong_integrator;
+              continue;
+            }
             for (const TEnd& te : t_ends) {
               double t_end = te.value;
               if (te.mode == "ref") t_end = info.reference_time > 0 ? info.reference_time : info.default_t_end;
               if (te.mode == "default") t_end = info.default_t_end;
+              if (ref_time > t_end)
+                throw MatrixError(set.find("ref_time")->value.where,
+                                  "ref_time: " + set.find("ref_time")->value.text + " is beyond t_end " +
+                                      format_short(t_end) + " (problem '" + info.name + "')");
               for (const auto* v : times)
                 if (v->number > t_end)
                   throw MatrixError(v->where, "times: " + v->text + " is beyond t_end " + format_short(t_end) +
@@ -825,11 +859,6 @@ Expansion expand_matrix(const MatrixFile& file, const MatrixCatalog& catalog) {
               std::vector<size_t> pick(applying.size(), 0);
               while (true) {
                 for (const StepSettings& st : settings) for (const double perturb : perturbs) {
-                  // A typo like 10 arrays of 100 values must not eat the machine.
-                  if (++combinations > kMaxCombinations || out.cases.size() >= kMaxCases)
-                    throw MatrixError(sec.where, "the matrix expands to more than " + std::to_string(kMaxCases) +
-                                                     " cases (or " + std::to_string(kMaxCombinations) +
-                                                     " combinations): split it into several files");
                   MatrixCase c;
                   RunConfig& cfg = c.config;
                   cfg.problem = info.name;
@@ -893,10 +922,20 @@ Expansion expand_matrix(const MatrixFile& file, const MatrixCatalog& catalog) {
       if (!pc.used && !optional)
         note("param." + (pc.method.empty() ? "" : pc.method + ".") + pc.name + " (line " +
              std::to_string(pc.where.line) + ") applies to no method of the sweep");
+    if (wrong_integrator)
+      note(std::to_string(wrong_integrator) + " method x integrator combinations skipped: DAE methods (ida-*) need "
+           "integrator 'ida', and 'ida' needs a DAE method");
+    if (out.cases.size() == cases_before && duplicates == duplicates_before && !optional) {
+      std::string why;
+      for (size_t i = notes_before; i < out.notes.size(); ++i) why += "; " + out.notes[i];
+      throw MatrixError(sec.where, "sweep '" + name + "' expands to no case" +
+                                       (why.empty() ? std::string() : why));
+    }
     if (not_applicable && (every_method || every_problem))
       note(std::to_string(not_applicable) + " problem x method combinations do not apply (see `cstab list`)");
   }
   if (duplicates) out.notes.push_back(std::to_string(duplicates) + " duplicate cases dropped (same configuration)");
+  if (sweep_number == 0) throw MatrixError({file.name, 1, 1}, "no [[sweep]] table: nothing to run");
   return out;
 }
 

@@ -159,7 +159,11 @@ constexpr int kStopSignals[] = {SIGINT, SIGTERM, SIGHUP};
 bool is_stop_signal(int sig) { return sig == SIGINT || sig == SIGTERM || sig == SIGHUP; }
 
 // While alive, SIGINT/SIGTERM/SIGHUP set g_stop_signal instead of killing
-// the process; the previous dispositions come back afterwards.
+// the process; the previous dispositions come back afterwards. A signal
+// ignored on entry (a background job of a non-interactive shell, nohup)
+// stays ignored, here and in the workers.
+bool g_ignored[std::size(kStopSignals)];
+
 class StopSignals {
  public:
   StopSignals() {
@@ -167,7 +171,11 @@ class StopSignals {
     struct sigaction sa {};
     sa.sa_handler = on_stop_signal;
     sigemptyset(&sa.sa_mask);
-    for (size_t i = 0; i < std::size(kStopSignals); ++i) ::sigaction(kStopSignals[i], &sa, &old_[i]);
+    for (size_t i = 0; i < std::size(kStopSignals); ++i) {
+      ::sigaction(kStopSignals[i], nullptr, &old_[i]);
+      g_ignored[i] = old_[i].sa_handler == SIG_IGN;
+      if (!g_ignored[i]) ::sigaction(kStopSignals[i], &sa, nullptr);
+    }
   }
   ~StopSignals() {
     for (size_t i = 0; i < std::size(kStopSignals); ++i) ::sigaction(kStopSignals[i], &old_[i], nullptr);
@@ -185,7 +193,7 @@ class StopSignals {
   }
   // In a worker: the default actions, so a stop signal ends it at once.
   static void defaults_in_child() {
-    for (int sig : kStopSignals) ::signal(sig, SIG_DFL);
+    for (size_t i = 0; i < std::size(kStopSignals); ++i) ::signal(kStopSignals[i], g_ignored[i] ? SIG_IGN : SIG_DFL);
     block(false);
   }
 

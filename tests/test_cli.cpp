@@ -158,8 +158,109 @@ std::vector<BadCase> bad_cases() {
       {"times_negative", with(kGood, "--times", "-0.01"), "--times"},
       {"unknown_option", with(kGood, "--no-such-option", "1"), "--no-such-option"},
       {"missing_problem", without(kGood, "--problem"), "--problem"},
+      // issue 9 audit
+      {"unknown_formulation", with(kGood, "--formulation", "lagrange"), "--formulation"},
+      {"formulation_of_another_method", with(with(kGood, "--method", "baumgarte"), "--formulation", "state-space"),
+       "--formulation"},
+      {"dae_method_with_rk4", with(kGood, "--method", "ida-ggl"), "--integrator"},
+      {"ode_method_with_ida", with(adaptive, "--integrator", "ida"), "--integrator"},
+      {"minimal_on_biped", with(with(kGood, "--problem", "biped"), "--method", "minimal"), "--method"},
+      {"step_larger_than_t_end", with(kGood, "--step", "1"), "--step"},
+      {"t_end_overflow", with(kGood, "--t-end", "1e999"), "--t-end"},
+      {"atol_negative", with(adaptive, "--atol", "-1e-6"), "--atol"},
+      {"tol_for_rk4", with(with(kGood, "--rtol", "1e-6"), "--atol", "1e-6"), "--rtol"},
+      {"step_given_twice", [] { auto a = kGood; a.insert(a.end(), {"--step", "1e-3"}); return a; }(), "--step"},
+      {"param_given_twice",
+       [] { auto a = kGood; a.insert(a.end(), {"--param", "lambda=1", "--param", "lambda=2"}); return a; }(),
+       "--param lambda"},
+      {"ref_time_negative", with(kGood, "--ref-time", "-2"), "--ref-time"},
+      {"ref_time_beyond_t_end", with(kGood, "--ref-time", "3"), "--ref-time"},
+      {"observe_every_zero", with(kGood, "--observe-every", "0"), "--observe-every"},
+      {"observe_every_overflows_int", with(kGood, "--observe-every", "99999999999999"), "--observe-every"},
+      {"observe_every_fraction", with(kGood, "--observe-every", "1.5"), "--observe-every"},
+      {"blowup_zero", with(kGood, "--blowup", "0"), "--blowup"},
+      {"sample_every_negative", with(kGood, "--sample-every", "-1"), "--sample-every"},
+      {"switch_with_value", with(kGood, "--no-series=1", "x"), "--no-series"},
+      {"positional_argument", [] { auto a = kGood; a.push_back("extra"); return a; }(), "extra"},
   };
 }
+
+// The other commands. `{out}` is replaced by a fresh folder below the
+// scratch folder; `{shard}` by a finished one-case matrix folder.
+struct OtherBadCase {
+  std::string label;
+  std::vector<std::string> args;
+  std::string names;
+};
+
+std::vector<OtherBadCase> other_bad_cases() {
+  const std::vector<std::string> stab = {"stability", "--problem", "wheel", "--method", "pesterev", "--integrator",
+                                         "rk4", "--gain-param", "lambda", "--steps", "1e-3", "--gains", "10",
+                                         "--t-end", "0.05", "--no-plot", "--out", "{out}"};
+  return {
+      {"stability_adaptive_integrator", with(stab, "--integrator", "rk8pd"), "--integrator"},
+      {"stability_steps_zero", with(stab, "--steps", "0"), "--steps"},
+      {"stability_gains_missing", without(stab, "--gains"), "--gains"},
+      {"stability_gains_negative", with(stab, "--gains", "10,-10"), "--gains"},
+      {"stability_gain_param_unknown", with(stab, "--gain-param", "foo"), "--param foo"},
+      {"stability_gain_param_also_given", with(stab, "--param", "lambda=5"), "--gain-param"},
+      {"stability_bisect_negative", with(stab, "--bisect", "-1"), "--bisect"},
+      {"stability_bisect_huge", with(stab, "--bisect", "100000000000"), "--bisect"},  // was a hang
+      {"stability_t_end_nan", with(stab, "--t-end", "nan"), "--t-end"},
+      {"matrix_missing_file", {"matrix", "/nonexistent/m.toml", "--out", "{out}"}, "/nonexistent/m.toml"},
+      {"matrix_folder_as_file", {"matrix", "/tmp", "--out", "{out}"}, "/tmp: is a folder"},
+      {"matrix_jobs_zero", {"matrix", "--jobs", "0", "--out", "{out}"}, "--jobs"},
+      {"matrix_jobs_garbage", {"matrix", "--jobs", "x", "--out", "{out}"}, "--jobs"},
+      {"matrix_shard_out_of_range", {"matrix", "--shard", "3/2", "--out", "{out}"}, "--shard"},
+      {"matrix_filter_matches_nothing", {"matrix", "--filter", "no-such-case", "--out", "{out}"}, "--filter"},
+      {"matrix_two_files", {"matrix", "a.toml", "b.toml", "--out", "{out}"}, "b.toml"},
+      {"merge_one_argument", {"merge", "{out}"}, "usage"},
+      {"merge_not_a_results_folder", {"merge", "{out}", "/tmp"}, "/tmp"},
+      {"merge_jobs_zero", {"merge", "{out}", "{shard}", "--jobs", "0"}, "--jobs"},  // used to write first
+      {"report_not_a_results_folder", {"report", "/tmp"}, "/tmp"},
+      {"report_jobs_zero", {"report", "{shard}", "--jobs", "0"}, "--jobs"},
+      {"list_extra_argument", {"list", "extra"}, "extra"},
+      {"unknown_command", {"frobnicate"}, "frobnicate"},
+  };
+}
+
+class OtherBadInput : public ::testing::TestWithParam<OtherBadCase> {};
+
+TEST_P(OtherBadInput, ExitsTwoWithOneLineNamingTheInputAndWritesNothing) {
+  const OtherBadCase& c = GetParam();
+  Scratch s;
+  const fs::path out = s.dir() / "out", shard = s.dir() / "shard";
+  bool needs_shard = false;
+  auto args = c.args;
+  for (auto& a : args) {
+    if (a == "{out}") a = out.string();
+    if (a == "{shard}") a = shard.string(), needs_shard = true;
+  }
+  if (needs_shard) {
+    std::ofstream(s.dir() / "one.toml") << "[[sweep]]\nproblems = [\"wheel\"]\nmethods = [\"pesterev\"]\n"
+                                           "integrators = \"rk4\"\nstep = 1e-3\nt_end = 0.01\n";
+    ASSERT_EQ(run_cli({"matrix", (s.dir() / "one.toml").string(), "--out", shard.string(), "--no-report"}, s.dir()).code,
+              0);
+  }
+  const auto shard_files = [&] {
+    std::vector<std::string> files;
+    if (fs::exists(shard))
+      for (const auto& e : fs::recursive_directory_iterator(shard)) files.push_back(e.path().string() + slurp(e.path()));
+    std::sort(files.begin(), files.end());
+    return files;
+  };
+  const auto before = shard_files();
+  const Outcome o = run_cli(args, s.dir());
+  EXPECT_EQ(o.code, 2) << "stderr: " << o.err;
+  ASSERT_FALSE(o.err.empty());
+  EXPECT_EQ(std::count(o.err.begin(), o.err.end(), '\n'), 1) << "not one line: " << o.err;
+  EXPECT_NE(o.err.find(c.names), std::string::npos) << "message does not name '" << c.names << "': " << o.err;
+  EXPECT_FALSE(fs::exists(out)) << "output folder created";
+  EXPECT_EQ(shard_files(), before) << "an input folder was modified";
+}
+
+INSTANTIATE_TEST_SUITE_P(Cli, OtherBadInput, ::testing::ValuesIn(other_bad_cases()),
+                         [](const auto& info) { return info.param.label; });
 
 class BadInput : public ::testing::TestWithParam<BadCase> {};
 
@@ -215,8 +316,6 @@ TEST(Cli, UnwritableOutUnderARegularFile) {
 
 // An existing folder that cannot take files, with --no-series: the folder
 // must be found unwritable before the run (exit 2), not after it.
-// DISABLED: fails today (exit 1 after the whole integration), see the fix
-// proposed for harness/run.cpp (probe the summary file before integrating).
 TEST(Cli, UnwritableOutWithoutSeries) {
   Scratch s;
   auto args = kGood;

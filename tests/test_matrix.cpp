@@ -14,6 +14,7 @@
 #include <fstream>
 #include <set>
 #include <sstream>
+#include <tuple>
 
 #include "cli/matrix_commands.hpp"
 #include "harness/matrix.hpp"
@@ -76,6 +77,73 @@ TEST(MatrixParse, ErrorsNameFileLineAndColumn) {
                                          "integrators = \"rk4\"\nstep = 1e-3\nparam.pesterev.lambdaa = 5\n");
   EXPECT_EQ(bad_param.substr(0, 12), "m.toml:6:1: ") << bad_param;
   EXPECT_NE(bad_param.find("no parameter 'lambdaa'"), std::string::npos) << bad_param;
+}
+
+// Issue 9 audit: every inconsistency is a MatrixError at the value that
+// causes it (or the sweep header when the sweep as a whole is impossible).
+TEST(MatrixExpand, RejectsImpossibleSettingsAtTheirLocation) {
+  const std::string head = std::string(kSweepHead) + "integrators = \"rk4\"\nstep = 1e-3\nt_end = 1\n";
+  const std::vector<std::tuple<std::string, std::string, std::string>> cases = {
+      // text, location, message part
+      {head + "param.lambda = [100, -5]\n", "m.toml:7:22: ", "must be > 0 for method 'pesterev'"},
+      {head + "param.pesterev.lambda = 0\n", "m.toml:7:25: ", "must be > 0"},
+      {head + "formulations = [\"lagrange\"]\n", "m.toml:7:17: ", "unknown formulation 'lagrange'"},
+      {head + "times = [0.5, 2]\n", "m.toml:7:15: ", "times: 2 is beyond t_end 1"},
+      {head + "times = -1\n", "m.toml:7:9: ", "must be > 0"},
+      {head + "ref_time = 2\n", "m.toml:7:12: ", "ref_time: 2 is beyond t_end 1"},
+      {head + "observe_every = 1e300\n", "m.toml:7:17: ", "observe_every"},  // was an int overflow
+      {head + "repeats = 1.5\n", "m.toml:7:11: ", "repeats"},
+      {head + "series = 1\n", "m.toml:7:10: ", "expected true/false"},
+      {head + "blowup = nan\n", "m.toml:7:10: ", "'nan' is not a finite number"},
+      {head + "timeout = inf\n", "m.toml:7:11: ", "'inf' is not a finite number"},
+      {head + "timeout = -inf\n", "m.toml:7:11: ", "'-inf' is not a finite number"},
+      {head + "timeout = 1e999\n", "m.toml:7:11: ", "'1e999' is not a finite number"},
+      {"[[sweep]]\nproblems = [\"wheel\"]\nmethods = [\"ida-ggl\"]\nintegrators = \"rk4\"\nstep = 1e-3\n",
+       "m.toml:1:1: ", "expands to no case"},
+      {"[[sweep]]\nproblems = [\"wheel\"]\nmethods = [\"pesterev\"]\nintegrators = \"ida\"\ntol = 1e-6\n",
+       "m.toml:1:1: ", "'ida' needs a DAE method"},
+      {"[[sweep]]\nproblems = [\"biped\"]\nmethods = [\"minimal\"]\nintegrators = \"rk4\"\nstep = 1e-3\n",
+       "m.toml:1:1: ", "minimal does not apply to biped"},
+      {"[[sweep]]\nproblems = [\"wheel\"]\nmethods = [\"pesterev\"]\nintegrators = \"rk4\"\nstep = 1\nt_end = 0.5\n",
+       "m.toml:1:1: ", "larger than t_end"},
+      {"", "m.toml:1:1: ", "no [[sweep]]"},
+      {"# only a comment\n[defaults]\nrepeats = 2\n", "m.toml:1:1: ", "no [[sweep]]"},
+      {"[[sweep]]\nproblems = \"all\"\nmethods = \"all\"\nintegrators = \"rk4\"\nstep = [1,2,3,4,5,6,7,8,9,10]\n"
+       "t_end = 100\nparam.alpha = [1,2,3,4,5,6,7,8,9,10,11,12,13,14,15,16,17,18,19,20,21,22,23,24,25,26,27,28,29,30,31,32,33,34,35,36,37,38,39,40]\n"
+       "param.beta = [1,2,3,4,5,6,7,8,9,10,11,12,13,14,15,16,17,18,19,20,21,22,23,24,25,26,27,28,29,30,31,32,33,34,35,36,37,38,39,40]\n"
+       "param.gamma = [1,2,3,4,5,6,7,8,9,10,11,12,13,14,15,16,17,18,19,20,21,22,23,24,25,26,27,28,29,30,31,32,33,34,35,36,37,38,39,40]\n",
+       "m.toml:1:1: ", "more than 100000 cases"},
+  };
+  for (const auto& [text, where, what] : cases) {
+    SCOPED_TRACE(text);
+    const std::string e = error_of(text);
+    EXPECT_EQ(e.substr(0, where.size()), where) << e;
+    EXPECT_NE(e.find(what), std::string::npos) << e;
+  }
+}
+
+// DAE methods meet only the DAE integrator, and the other way round: with
+// methods = "all" the impossible pairs are skipped (not run as "invalid").
+TEST(MatrixExpand, DaeMethodsMeetOnlyTheDaeIntegrator) {
+  const auto ex = expand_matrix(parse_matrix("[[sweep]]\nproblems = [\"wheel\"]\nmethods = \"all\"\n"
+                                             "integrators = [\"rk4\", \"ida\"]\nstep = 1e-3\ntol = 1e-6\nt_end = 1\n",
+                                             "m.toml"),
+                                registry_catalog());
+  std::set<std::string> with_ida, with_rk4;
+  for (const auto& c : ex.cases) (c.entry.integrator == "ida" ? with_ida : with_rk4).insert(c.entry.method);
+  EXPECT_EQ(with_ida, (std::set<std::string>{"ida-index1", "ida-ggl"}));
+  EXPECT_FALSE(with_rk4.count("ida-ggl"));
+  EXPECT_FALSE(with_rk4.count("ida-index1"));
+  EXPECT_TRUE(with_rk4.count("pesterev"));
+}
+
+TEST(MatrixParse, AFolderIsNotAMatrixFile) {
+  try {
+    read_matrix_file("/tmp");
+    ADD_FAILURE() << "read a folder";
+  } catch (const UsageError& e) {
+    EXPECT_NE(std::string(e.what()).find("/tmp: is a folder"), std::string::npos) << e.what();
+  }
 }
 
 TEST(MatrixParse, ReadsTheTomlSubset) {
@@ -301,15 +369,15 @@ TEST_F(MatrixRun, SingleRunWritesResultsPlotsAndReport) {
 TEST_F(MatrixRun, UnchangedRerunRunsNothing) {
   ASSERT_EQ(single_.code, 0) << single_.text;
   const std::string before = slurp(dir_ + "/single/summary.csv");
-  const auto start = std::chrono::steady_clock::now();
   const Output again = sh(std::string(CSTAB_BINARY) + " matrix " + dir_ + "/tiny.toml --out " + dir_ + "/single");
-  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   ASSERT_EQ(again.code, 0) << again.text;
   EXPECT_NE(again.text.find("10 of 10 cases cached"), std::string::npos) << again.text;
   EXPECT_NE(again.text.find("0 run, 10 cached"), std::string::npos) << again.text;
   EXPECT_NE(again.text.find("0 plots drawn"), std::string::npos) << again.text;
   EXPECT_EQ(slurp(dir_ + "/single/summary.csv"), before);  // nothing rerun: even the timings are the same
-  EXPECT_LT(seconds, 5.0);
+  // No wall-time bound here (a timed test fails under the sanitizers and on a
+  // loaded machine): "0 run", "0 plots drawn" and the unchanged summary say
+  // that nothing was redone.
 }
 
 TEST_F(MatrixRun, TwoShardsThroughGnuParallelMergeToTheSingleRun) {

@@ -13,6 +13,7 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <sstream>
 #include <string>
 #include <thread>
 #include <vector>
@@ -264,6 +265,53 @@ TEST(Determinism, TwoRunsWriteIdenticalSeries) {
   }
 }
 
+// In a forked child before exec: the default actions for the signals the
+// tests send (a background job of a non-interactive shell inherits SIGINT
+// ignored, and cstab rightly keeps it so).
+void default_signals() {
+  for (int sig : {SIGINT, SIGTERM, SIGHUP}) ::signal(sig, SIG_DFL);
+}
+
+// ---------------------------------------------------------------------------
+// An interrupted `cstab run` leaves neither a half-written file nor a
+// temporary: it dies of the signal with an empty output folder.
+
+TEST(Interrupt, RunLeavesNoFileBehind) {
+  for (int sig : {SIGINT, SIGTERM}) {
+    SCOPED_TRACE(sig);
+    Scratch s;
+    const fs::path out = s.dir() / "out";
+    const pid_t pid = ::fork();
+    if (pid == 0) {
+      default_signals();
+      const int fd = ::open("/dev/null", O_WRONLY);
+      ::dup2(fd, 1);
+      ::dup2(fd, 2);
+      ::execl(CSTAB_BINARY, CSTAB_BINARY, "run", "--problem", "wheel", "--method", "pesterev", "--integrator", "rk4",
+              "--step", "1e-5", "--t-end", "200", "--sample-every", "1e-4", "--out", out.c_str(),
+              static_cast<char*>(nullptr));
+      ::_exit(127);
+    }
+    // Wait until the temporaries exist (the run is integrating), then signal.
+    bool writing = false;
+    for (int i = 0; i < 20000 && !writing; ++i) {
+      std::error_code ec;
+      for (const auto& e : fs::directory_iterator(out, ec))
+        if (e.path().filename().string().find(".tmp.") != std::string::npos) writing = true;
+      if (!writing) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    }
+    EXPECT_TRUE(writing);
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    ::kill(pid, sig);
+    int status = 0;
+    ::waitpid(pid, &status, 0);
+    EXPECT_TRUE(WIFSIGNALED(status) && WTERMSIG(status) == sig) << status;
+    std::vector<std::string> left;
+    for (const auto& e : fs::directory_iterator(out)) left.push_back(e.path().filename().string());
+    EXPECT_TRUE(left.empty()) << left.front();
+  }
+}
+
 // ---------------------------------------------------------------------------
 // Interruption: SIGINT to the process group (Ctrl-C) and SIGTERM to the
 // matrix process alone both keep every finished case; the rerun resumes and
@@ -335,6 +383,7 @@ class MatrixInterrupt : public ::testing::Test {
     const pid_t pid = ::fork();
     if (pid == 0) {
       ::setpgid(0, 0);
+      default_signals();
       const int fd = ::open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
       ::dup2(fd, 1);
       ::dup2(fd, 2);
@@ -438,17 +487,41 @@ problems = ["wheel"]
 methods = ["pesterev"]
 integrators = "rk4"
 step = 1e-5
-t_end = 200
+t_end = 20
 ref_time = 0
 series = false
 )";
   const pid_t pid = spawn(s.dir() / "one.toml", s.dir() / "out", "1", s.dir() / "log");
-  // Kill the worker (the matrix process's child) once it runs.
+  // Kill the worker once it runs: the matrix process's child that is the
+  // cstab binary itself (a fork), not a helper such as the shells that
+  // collect the provenance.
+  const fs::path binary = fs::canonical(CSTAB_BINARY);
   bool killed = false;
-  for (int i = 0; i < 2000 && !killed; ++i) {
-    const Outcome child = sh("pgrep -P " + std::to_string(pid));
-    if (child.code == 0) killed = sh("kill -TERM " + child.out.substr(0, child.out.find('\n'))).code == 0;
-    else std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  for (int i = 0; i < 4000 && !killed; ++i) {
+    std::error_code ec;
+    // The case folder is created just before the worker is forked (and
+    // after the provenance helpers have finished).
+    if (fs::is_empty(s.dir() / "out" / "cases", ec) || ec) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(2));
+      continue;
+    }
+    for (const auto& e : fs::directory_iterator("/proc", ec)) {
+      const std::string name = e.path().filename().string();
+      if (name.find_first_not_of("0123456789") != std::string::npos) continue;
+      std::ifstream stat(e.path() / "stat");
+      std::string line;
+      std::getline(stat, line);
+      // "pid (comm) state ppid ...": the ppid after the closing parenthesis.
+      const size_t close = line.rfind(')');
+      if (close == std::string::npos) continue;
+      std::istringstream rest(line.substr(close + 1));
+      std::string state;
+      long ppid = 0;
+      rest >> state >> ppid;
+      if (ppid != pid || fs::read_symlink(e.path() / "exe", ec) != binary) continue;
+      killed = ::kill(pid_t(std::stol(name)), SIGTERM) == 0;
+    }
+    if (!killed) std::this_thread::sleep_for(std::chrono::milliseconds(5));
   }
   EXPECT_TRUE(killed);
   int status = 0;

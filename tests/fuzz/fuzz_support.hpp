@@ -54,7 +54,7 @@ inline const MatrixCatalog& catalog() {
     for (const char* m : {"pesterev", "baumgarte", "shift", "none", "minimal"}) {
       MethodInfo info;
       info.name = m;
-      info.params = ball.method_params(m, "");
+      info.params = wheel.method_params(m, "");
       out.methods.push_back(info);
     }
     return out;

@@ -1,0 +1,183 @@
+#!/usr/bin/env bash
+# The bad-input table of issue 9: every kind of bad input on every command
+# (run, stability, matrix and matrix files, merge, report, list), with what
+# it got: exit code, first line of stderr, number of stderr lines, files left
+# in the output folder. Markdown on stdout. Usage: bash scripts/bad-input-table.sh
+# (uses build/release/cli/cstab, or $CSTAB). Each case: label|arguments,
+# OUT = a fresh output folder, SHARD = a finished one-case results folder.
+set -u
+cd "$(dirname "$0")/.."
+B="${CSTAB:-$(pwd)/build/release/cli/cstab}"
+W=$(mktemp -d /tmp/cstab-bad-input-XXXXXX)
+trap 'rm -rf "$W"' EXIT
+G="--problem wheel --method pesterev --integrator rk4 --step 1e-3 --t-end 0.05"
+A="--problem wheel --method pesterev --integrator rk8pd --rtol 1e-6 --atol 1e-6 --t-end 0.05"
+S="--problem wheel --method pesterev --integrator rk4 --gain-param lambda --steps 1e-3 --gains 10 --t-end 0.05 --no-plot"
+M=$W/m
+mkdir -p $M
+w() { printf '%b' "$2" > $M/$1.toml; }
+w good '[[sweep]]\nproblems = ["wheel"]\nmethods = ["pesterev"]\nintegrators = "rk4"\nstep = 1e-3\nt_end = 0.05\n'
+w unknown_key '[[sweep]]\nproblems = ["wheel"]\nmethods = ["pesterev"]\nintegrators = "rk4"\nstep = 1e-3\nt_end = 0.05\nstpe = 1\n'
+w wrong_type '[[sweep]]\nproblems = ["wheel"]\nmethods = ["pesterev"]\nintegrators = "rk4"\nstep = "fast"\nt_end = 0.05\n'
+w nan '[[sweep]]\nproblems = ["wheel"]\nmethods = ["pesterev"]\nintegrators = "rk4"\nstep = nan\nt_end = 0.05\n'
+w inf '[[sweep]]\nproblems = ["wheel"]\nmethods = ["pesterev"]\nintegrators = "rk4"\nstep = inf\nt_end = 0.05\n'
+w overflow '[[sweep]]\nproblems = ["wheel"]\nmethods = ["pesterev"]\nintegrators = "rk4"\nstep = 1e999\nt_end = 0.05\n'
+w step_zero '[[sweep]]\nproblems = ["wheel"]\nmethods = ["pesterev"]\nintegrators = "rk4"\nstep = 0\nt_end = 0.05\n'
+w step_negative '[[sweep]]\nproblems = ["wheel"]\nmethods = ["pesterev"]\nintegrators = "rk4"\nstep = [1e-3, -1e-3]\nt_end = 0.05\n'
+w t_end_zero '[[sweep]]\nproblems = ["wheel"]\nmethods = ["pesterev"]\nintegrators = "rk4"\nstep = 1e-3\nt_end = 0\n'
+w t_end_negative '[[sweep]]\nproblems = ["wheel"]\nmethods = ["pesterev"]\nintegrators = "rk4"\nstep = 1e-3\nt_end = -1\n'
+w tol_zero '[[sweep]]\nproblems = ["wheel"]\nmethods = ["pesterev"]\nintegrators = "rk8pd"\ntol = 0\nt_end = 0.05\n'
+w tol_negative '[[sweep]]\nproblems = ["wheel"]\nmethods = ["pesterev"]\nintegrators = "rk8pd"\nrtol = -1e-6\natol = 1e-6\nt_end = 0.05\n'
+w tol_and_rtol '[[sweep]]\nproblems = ["wheel"]\nmethods = ["pesterev"]\nintegrators = "rk8pd"\ntol = 1e-6\nrtol = 1e-6\nt_end = 0.05\n'
+w rtol_alone '[[sweep]]\nproblems = ["wheel"]\nmethods = ["pesterev"]\nintegrators = "rk8pd"\nrtol = 1e-6\nt_end = 0.05\n'
+w step_for_adaptive '[[sweep]]\nproblems = ["wheel"]\nmethods = ["pesterev"]\nintegrators = "rk8pd"\nstep = 1e-3\nt_end = 0.05\n'
+w no_step '[[sweep]]\nproblems = ["wheel"]\nmethods = ["pesterev"]\nintegrators = "rk4"\nt_end = 0.05\n'
+w param_negative '[[sweep]]\nproblems = ["wheel"]\nmethods = ["pesterev"]\nintegrators = "rk4"\nstep = 1e-3\nt_end = 0.05\nparam.lambda = -5\n'
+w param_string '[[sweep]]\nproblems = ["wheel"]\nmethods = ["pesterev"]\nintegrators = "rk4"\nstep = 1e-3\nt_end = 0.05\nparam.lambda = "big"\n'
+w param_unknown_method '[[sweep]]\nproblems = ["wheel"]\nmethods = ["pesterev"]\nintegrators = "rk4"\nstep = 1e-3\nt_end = 0.05\nparam.pesterv.lambda = 5\n'
+w param_unknown_name '[[sweep]]\nproblems = ["wheel"]\nmethods = ["pesterev"]\nintegrators = "rk4"\nstep = 1e-3\nt_end = 0.05\nparam.pesterev.lamda = 5\n'
+w unknown_problem '[[sweep]]\nproblems = ["whel"]\nmethods = ["pesterev"]\nintegrators = "rk4"\nstep = 1e-3\nt_end = 0.05\n'
+w unknown_method '[[sweep]]\nproblems = ["wheel"]\nmethods = ["pesterv"]\nintegrators = "rk4"\nstep = 1e-3\nt_end = 0.05\n'
+w unknown_integrator '[[sweep]]\nproblems = ["wheel"]\nmethods = ["pesterev"]\nintegrators = "rk5"\nstep = 1e-3\nt_end = 0.05\n'
+w unknown_formulation '[[sweep]]\nproblems = ["wheel"]\nmethods = ["pesterev"]\nformulations = ["lagrange"]\nintegrators = "rk4"\nstep = 1e-3\nt_end = 0.05\n'
+w dae_method_ode_integrator '[[sweep]]\nproblems = ["wheel"]\nmethods = ["ida-ggl"]\nintegrators = "rk4"\nstep = 1e-3\nt_end = 0.05\n'
+w ode_method_ida '[[sweep]]\nproblems = ["wheel"]\nmethods = ["pesterev"]\nintegrators = "ida"\ntol = 1e-6\nt_end = 0.05\n'
+w method_not_applicable '[[sweep]]\nproblems = ["biped"]\nmethods = ["minimal"]\nintegrators = "rk4"\nstep = 1e-3\nt_end = 0.05\n'
+w times_beyond '[[sweep]]\nproblems = ["wheel"]\nmethods = ["pesterev"]\nintegrators = "rk4"\nstep = 1e-3\nt_end = 0.05\ntimes = [0.01, 7]\n'
+w times_negative '[[sweep]]\nproblems = ["wheel"]\nmethods = ["pesterev"]\nintegrators = "rk4"\nstep = 1e-3\nt_end = 0.05\ntimes = -1\n'
+w repeats_zero '[[sweep]]\nproblems = ["wheel"]\nmethods = ["pesterev"]\nintegrators = "rk4"\nstep = 1e-3\nt_end = 0.05\nrepeats = 0\n'
+w repeats_fraction '[[sweep]]\nproblems = ["wheel"]\nmethods = ["pesterev"]\nintegrators = "rk4"\nstep = 1e-3\nt_end = 0.05\nrepeats = 1.5\n'
+w observe_huge '[[sweep]]\nproblems = ["wheel"]\nmethods = ["pesterev"]\nintegrators = "rk4"\nstep = 1e-3\nt_end = 0.05\nobserve_every = 1e300\n'
+w blowup_zero '[[sweep]]\nproblems = ["wheel"]\nmethods = ["pesterev"]\nintegrators = "rk4"\nstep = 1e-3\nt_end = 0.05\nblowup = 0\n'
+w timeout_negative '[[sweep]]\nproblems = ["wheel"]\nmethods = ["pesterev"]\nintegrators = "rk4"\nstep = 1e-3\nt_end = 0.05\ntimeout = -1\n'
+w series_number '[[sweep]]\nproblems = ["wheel"]\nmethods = ["pesterev"]\nintegrators = "rk4"\nstep = 1e-3\nt_end = 0.05\nseries = 1\n'
+w sample_negative '[[sweep]]\nproblems = ["wheel"]\nmethods = ["pesterev"]\nintegrators = "rk4"\nstep = 1e-3\nt_end = 0.05\nsample_every = -1\n'
+w ref_time_negative '[[sweep]]\nproblems = ["wheel"]\nmethods = ["pesterev"]\nintegrators = "rk4"\nstep = 1e-3\nt_end = 0.05\nref_time = -1\n'
+w empty_array '[[sweep]]\nproblems = []\nmethods = ["pesterev"]\nintegrators = "rk4"\nstep = 1e-3\nt_end = 0.05\n'
+w mixed_array '[[sweep]]\nproblems = ["wheel"]\nmethods = ["pesterev"]\nintegrators = "rk4"\nstep = [1e-3, "x"]\nt_end = 0.05\n'
+w nested_array '[[sweep]]\nproblems = ["wheel"]\nmethods = ["pesterev"]\nintegrators = "rk4"\nstep = [[1e-3]]\nt_end = 0.05\n'
+w unterminated_string '[[sweep]]\nproblems = ["wheel]\n'
+w bad_section '[sweeps]\n'
+w key_outside '\nstep = 1\n'
+w duplicate_key '[[sweep]]\nstep = 1\nstep = 2\n'
+w duplicate_name '[[sweep]]\nname = "a"\nproblems = ["wheel"]\nmethods = ["pesterev"]\nintegrators = "rk4"\nstep = 1e-3\nt_end = 0.05\n[[sweep]]\nname = "a"\nproblems = ["wheel"]\nmethods = ["pesterev"]\nintegrators = "rk4"\nstep = 1e-3\nt_end = 0.05\n'
+w huge_product '[[sweep]]\nproblems = "all"\nmethods = "all"\nintegrators = "rk4"\nstep = [1,2,3,4,5,6,7,8,9,10,11,12,13,14,15,16,17,18,19,20,21,22,23,24,25,26,27,28,29,30,31,32,33,34,35,36,37,38,39,40,41,42,43,44,45,46,47,48,49,50]\nt_end = 100\nparam.lambda = [1,2,3,4,5,6,7,8,9,10,11,12,13,14,15,16,17,18,19,20,21,22,23,24,25,26,27,28,29,30,31,32,33,34,35,36,37,38,39,40,41,42,43,44,45,46,47,48,49,50]\nparam.alpha = [1,2,3,4,5,6,7,8,9,10,11,12,13,14,15,16,17,18,19,20,21,22,23,24,25,26,27,28,29,30,31,32,33,34,35,36,37,38,39,40,41,42,43,44,45,46,47,48,49,50]\nparam.beta = [1,2,3,4,5,6,7,8,9,10,11,12,13,14,15,16,17,18,19,20,21,22,23,24,25,26,27,28,29,30,31,32,33,34,35,36,37,38,39,40,41,42,43,44,45,46,47,48,49,50]\n'
+w binary_garbage '\x00\xff\xfe[[sweep]]\n'
+w empty_file ''
+w no_sweep '[defaults]\nrepeats = 2\n'
+
+cases=(
+"run_unknown_problem|run ${G/wheel/nope} --out OUT"
+"run_unknown_method|run ${G/pesterev/nope} --out OUT"
+"run_unknown_formulation|run $G --formulation lagrange --out OUT"
+"run_wrong_formulation_for_method|run ${G/pesterev/baumgarte} --formulation state-space --out OUT"
+"run_unknown_integrator|run ${G/rk4/rk5} --out OUT"
+"run_unknown_flag|run $G --stpe 1 --out OUT"
+"run_flag_twice|run $G --step 1e-3 --out OUT"
+"run_missing_value|run $G --out"
+"run_positional|run $G extra --out OUT"
+"run_step_zero|run ${G/--step 1e-3/--step 0} --out OUT"
+"run_step_negative|run ${G/--step 1e-3/--step -1e-3} --out OUT"
+"run_step_nan|run ${G/--step 1e-3/--step nan} --out OUT"
+"run_step_inf|run ${G/--step 1e-3/--step inf} --out OUT"
+"run_step_hex|run ${G/--step 1e-3/--step 0x1p-10} --out OUT"
+"run_step_empty|run ${G/--step 1e-3/--step=} --out OUT"
+"run_step_gt_t_end|run ${G/--step 1e-3/--step 1} --out OUT"
+"run_t_end_zero|run ${G/--t-end 0.05/--t-end 0} --out OUT"
+"run_t_end_inf|run ${G/--t-end 0.05/--t-end inf} --out OUT"
+"run_t_end_1e999|run ${G/--t-end 0.05/--t-end 1e999} --out OUT"
+"run_rtol_zero|run ${A/--rtol 1e-6/--rtol 0} --out OUT"
+"run_atol_negative|run ${A/--atol 1e-6/--atol -1} --out OUT"
+"run_atol_nan|run ${A/--atol 1e-6/--atol nan} --out OUT"
+"run_tol_for_rk4|run $G --rtol 1e-6 --atol 1e-6 --out OUT"
+"run_step_for_rk8pd|run $A --step 1e-3 --out OUT"
+"run_dae_method_ode_integrator|run ${G/pesterev/ida-ggl} --out OUT"
+"run_ode_method_ida|run ${A/rk8pd/ida} --out OUT"
+"run_method_not_applicable|run ${G/wheel --method pesterev/biped --method minimal} --out OUT"
+"run_param_unknown|run $G --param foo=1 --out OUT"
+"run_param_negative|run $G --param lambda=-1 --out OUT"
+"run_param_nan|run $G --param lambda=nan --out OUT"
+"run_param_twice|run $G --param lambda=1 --param lambda=2 --out OUT"
+"run_param_no_eq|run $G --param lambda --out OUT"
+"run_param_for_none|run ${G/pesterev/none} --param lambda=1 --out OUT"
+"run_times_beyond|run $G --times 1 --out OUT"
+"run_times_zero|run $G --times 0 --out OUT"
+"run_times_garbage|run $G --times 0.01,,0.02 --out OUT"
+"run_sample_negative|run $G --sample-every -1 --out OUT"
+"run_ref_time_negative|run $G --ref-time -2 --out OUT"
+"run_ref_time_beyond|run $G --ref-time 3 --out OUT"
+"run_ref_time_nan|run $G --ref-time nan --out OUT"
+"run_blowup_zero|run $G --blowup 0 --out OUT"
+"run_observe_zero|run $G --observe-every 0 --out OUT"
+"run_observe_huge|run $G --observe-every 99999999999999 --out OUT"
+"run_observe_fraction|run $G --observe-every 1.5 --out OUT"
+"run_out_missing|run $G"
+"run_out_file|run $G --out /etc/passwd"
+"run_out_proc|run $G --out /proc/x"
+"run_no_series_proc|run $G --no-series --out /proc"
+"run_switch_with_value|run $G --no-series=1 --out OUT"
+"stab_adaptive|stability ${S/rk4/rk8pd} --out OUT"
+"stab_steps_zero|stability ${S/--steps 1e-3/--steps 0} --out OUT"
+"stab_steps_empty|stability ${S/--steps 1e-3/--steps=} --out OUT"
+"stab_gains_missing|stability ${S/--gains 10/} --out OUT"
+"stab_gains_negative|stability ${S/--gains 10/--gains -10} --out OUT"
+"stab_gain_param_unknown|stability ${S/--gain-param lambda/--gain-param foo} --out OUT"
+"stab_gain_param_also_param|stability $S --param lambda=5 --out OUT"
+"stab_t_end_nan|stability ${S/--t-end 0.05/--t-end nan} --out OUT"
+"stab_bisect_negative|stability $S --bisect -1 --out OUT"
+"stab_bisect_huge|stability $S --bisect 100000000000 --out OUT"
+"stab_blowup_zero|stability $S --blowup 0 --out OUT"
+"stab_step_gt_t_end|stability ${S/--steps 1e-3/--steps 1} --out OUT"
+"stab_out_file|stability $S --out /etc/passwd"
+"stab_unknown_problem|stability ${S/wheel/nope} --out OUT"
+"mat_missing_file|matrix /nonexistent.toml --out OUT"
+"mat_folder_as_file|matrix /tmp --out OUT"
+"mat_two_files|matrix $M/good.toml $M/good.toml --out OUT"
+"mat_no_out|matrix $M/good.toml"
+"mat_jobs_zero|matrix $M/good.toml --jobs 0 --out OUT"
+"mat_jobs_garbage|matrix $M/good.toml --jobs x --out OUT"
+"mat_jobs_huge|matrix $M/good.toml --jobs 99999999999999999999 --out OUT"
+"mat_shard_bad|matrix $M/good.toml --shard 3/2 --out OUT"
+"mat_shard_garbage|matrix $M/good.toml --shard a/b --out OUT"
+"mat_shard_zero|matrix $M/good.toml --shard 0/0 --out OUT"
+"mat_out_file|matrix $M/good.toml --out /etc/passwd"
+"mat_out_proc|matrix $M/good.toml --out /proc/x"
+"mat_unknown_flag|matrix $M/good.toml --frobnicate --out OUT"
+"mat_filter_nothing|matrix $M/good.toml --filter nothing-matches --out OUT"
+)
+for f in $M/*.toml; do n=$(basename $f .toml); [ $n = good ] && continue; cases+=("matfile_$n|matrix $f --out OUT"); done
+cases+=(
+"merge_no_args|merge"
+"merge_one_arg|merge OUT"
+"merge_not_results|merge OUT /tmp"
+"merge_missing_shard|merge OUT /nonexistent"
+"merge_into_shard|merge SHARD SHARD"
+"merge_jobs_zero|merge OUT SHARD --jobs 0"
+"merge_bad_flag|merge OUT SHARD --frob"
+"report_no_args|report"
+"report_not_results|report /tmp"
+"report_missing|report /nonexistent"
+"report_jobs_zero|report SHARD --jobs 0"
+"report_two|report SHARD SHARD"
+"list_extra|list extra"
+"list_flag|list --foo"
+"unknown_command|frobnicate"
+)
+# a finished shard for merge/report cases
+rm -rf $W/shard; $B matrix $M/good.toml --out $W/shard --no-report >/dev/null 2>&1
+shard_before=$(cd $W/shard && find . -type f | sort | xargs md5sum | md5sum)
+printf '| # | input | exit | message (stderr, first line) | lines | files left |\n|---|---|---|---|---|---|\n'
+i=0
+for c in "${cases[@]}"; do
+  i=$((i+1))
+  label=${c%%|*}; args=${c#*|}
+  out=$W/out_$i; rm -rf $out
+  args=${args//OUT/$out}; args=${args//SHARD/$W/shard}
+  $B $args >$W/stdout 2>$W/stderr; code=$?
+  msg=$(head -1 $W/stderr | sed "s|$W/||g; s/|/\\\\|/g" | cut -c1-170)
+  lines=$(wc -l < $W/stderr)
+  if [ -e $out ]; then left=$(find $out -type f | sed "s|$out/||" | tr '\n' ' '); [ -z "$left" ] && left="(empty folder)"; else left="none"; fi
+  printf '| %d | %s | %s | %s | %s | %s |\n' "$i" "$label" "$code" "$msg" "$lines" "$left"
+done
+shard_after=$(cd $W/shard && find . -type f | sort | xargs md5sum | md5sum)
+[ "$shard_before" = "$shard_after" ] && echo "shard folder unchanged by the merge/report cases" || echo "shard folder CHANGED"
