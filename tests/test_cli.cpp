@@ -301,7 +301,7 @@ TEST(Cli, UnwritableOutUnderARegularFile) {
   Scratch s;
   const fs::path file = s.dir() / "plain";
   std::ofstream(file) << "x\n";
-  for (const fs::path out : {file / "sub", file}) {
+  for (const fs::path& out : {file / "sub", file}) {
     SCOPED_TRACE(out.string());
     auto args = kGood;
     args.insert(args.end(), {"--out", out.string()});

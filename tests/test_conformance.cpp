@@ -94,7 +94,9 @@ TEST_P(Conformance, StaysOnManifoldAndMatchesReference) {
     EXPECT_TRUE(std::isfinite(r.max_residual));
   } else {
     EXPECT_LT(r.final_residual, 1e-6) << "residual at t_end";
-    if (consistent_start) EXPECT_LT(r.max_residual, 1e-6);
+    if (consistent_start) {
+      EXPECT_LT(r.max_residual, 1e-6);
+    }
   }
   if (problem.info().has_energy && consistent_start && method != "none") {
     EXPECT_LT(r.max_energy_drift, 1e-5);
