@@ -18,6 +18,7 @@
 
 #include "cli/matrix_commands.hpp"
 #include "harness/matrix.hpp"
+#include "tests/test_util.hpp"
 #include "methods/dispatch.hpp"
 #include "problems/registry.hpp"
 
@@ -283,21 +284,6 @@ std::string slurp(const std::string& path) {
   return s.str();
 }
 
-// summary.csv without the timing columns.
-std::string without_timing(const std::string& path) {
-  const CsvTable t = read_csv(path);
-  std::string out;
-  std::vector<size_t> keep;
-  for (size_t i = 0; i < t.header.size(); ++i)
-    if (t.header[i] != "wall_seconds" && t.header[i] != "observe_seconds") keep.push_back(i);
-  for (size_t i : keep) out += t.header[i] + ",";
-  out += "\n";
-  for (const auto& row : t.rows) {
-    for (size_t i : keep) out += (i < row.size() ? row[i] : "") + ",";
-    out += "\n";
-  }
-  return out;
-}
 
 class MatrixRun : public ::testing::Test {
  protected:
@@ -394,7 +380,8 @@ TEST_F(MatrixRun, TwoShardsThroughGnuParallelMergeToTheSingleRun) {
   const Output merge = sh(std::string(CSTAB_BINARY) + " merge " + dir_ + "/merged " + dir_ + "/shard1 " + dir_ +
                           "/shard2 --no-report");
   ASSERT_EQ(merge.code, 0) << merge.text;
-  EXPECT_EQ(without_timing(dir_ + "/merged/summary.csv"), without_timing(dir_ + "/single/summary.csv"));
+  EXPECT_EQ(cstab::testing::summary_without_timing(dir_ + "/merged/summary.csv"),
+            cstab::testing::summary_without_timing(dir_ + "/single/summary.csv"));
   EXPECT_EQ(slurp(dir_ + "/merged/cases.csv"), slurp(dir_ + "/single/cases.csv"));
   // A missing shard is reported, with exit code 3.
   const Output partial = sh(std::string(CSTAB_BINARY) + " merge " + dir_ + "/partial " + dir_ + "/shard1 --no-report");

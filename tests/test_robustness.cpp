@@ -335,21 +335,6 @@ integrators = "rk8pd"
 tol = 1e-11
 )";
 
-// summary.csv without the timing columns.
-std::string without_timing(const fs::path& path) {
-  const CsvTable t = read_csv(path.string());
-  std::string out;
-  std::vector<size_t> keep;
-  for (size_t i = 0; i < t.header.size(); ++i)
-    if (t.header[i] != "wall_seconds" && t.header[i] != "observe_seconds") keep.push_back(i);
-  for (size_t i : keep) out += t.header[i] + ",";
-  out += "\n";
-  for (const auto& row : t.rows) {
-    for (size_t i : keep) out += (i < row.size() ? row[i] : "") + ",";
-    out += "\n";
-  }
-  return out;
-}
 
 size_t finished_cases(const fs::path& out) {
   size_t n = 0;
@@ -458,7 +443,8 @@ class MatrixInterrupt : public ::testing::Test {
     EXPECT_NE(again.out.find(std::to_string(total - kept) + " run, " + std::to_string(kept) + " cached"),
               std::string::npos)
         << again.out;
-    EXPECT_EQ(without_timing(out / "summary.csv"), without_timing(dir_->dir() / "full" / "summary.csv"));
+    EXPECT_EQ(cstab::testing::summary_without_timing(out / "summary.csv"),
+              cstab::testing::summary_without_timing(dir_->dir() / "full" / "summary.csv"));
   }
 
   static Scratch* dir_;

@@ -9,6 +9,9 @@
 #include <sstream>
 #include <stdexcept>
 #include <string>
+#include <vector>
+
+#include "harness/matrix.hpp"
 
 namespace cstab::testing {
 
@@ -51,5 +54,22 @@ class Scratch {
  private:
   std::filesystem::path dir_;
 };
+
+// A summary.csv without its timing columns (wall_seconds, observe_seconds):
+// what two runs of the same cases must agree on.
+inline std::string summary_without_timing(const std::filesystem::path& path) {
+  const CsvTable t = read_csv(path.string());
+  std::vector<size_t> keep;
+  for (size_t i = 0; i < t.header.size(); ++i)
+    if (t.header[i] != "wall_seconds" && t.header[i] != "observe_seconds") keep.push_back(i);
+  std::string out;
+  for (size_t i : keep) out += t.header[i] + ",";
+  out += "\n";
+  for (const auto& row : t.rows) {
+    for (size_t i : keep) out += (i < row.size() ? row[i] : "") + ",";
+    out += "\n";
+  }
+  return out;
+}
 
 }  // namespace cstab::testing
