@@ -16,7 +16,13 @@ built=$(date +%s)
 export ASAN_OPTIONS="halt_on_error=1:abort_on_error=1:detect_leaks=1:strict_string_checks=1:detect_stack_use_after_return=1${ASAN_OPTIONS:+:$ASAN_OPTIONS}"
 export UBSAN_OPTIONS="halt_on_error=1:abort_on_error=1:print_stacktrace=1${UBSAN_OPTIONS:+:$UBSAN_OPTIONS}"
 status=0
-(cd build/sanitize && ctest --output-on-failure -j"$JOBS" --timeout 1800 "$@") || status=$?
+# The gate's committed timing rows (cstab / IDA-GGL wall-time ratios) do not
+# hold under instrumentation: ASan slows cstab's code, not the uninstrumented
+# SUNDIALS library (measured 0.38 and 1.01 against bounds 0.2 and 0.6; every
+# accuracy check of that test passed). The test is excluded here, the
+# degraded-configuration gate test still runs.
+(cd build/sanitize && ctest --output-on-failure -j"$JOBS" --timeout 1800 \
+   -E 'GateMatrix.CommittedThresholdsPassOnTheGateMatrix' "$@") || status=$?
 end=$(date +%s)
 echo "sanitize: build $((built - start)) s, tests $((end - built)) s, exit $status"
 exit $status
