@@ -57,7 +57,18 @@ class LieJet {
   Vec<double, n> F;
   Eigen::Matrix<double, n, m> B;
 
+  // A model may provide the jet in closed form,
+  //   template <class Jet> void closed_form_jet(double t, const Vec<double, n>& X, Jet& jet) const;
+  // filling F, B, A, top and lower as evaluate_ad would (a hand-derived fast
+  // path: its test compares it with evaluate_ad). Otherwise nested AD.
   void evaluate(const Model& model, double t, const Vec<double, n>& X) {
+    if constexpr (requires { model.closed_form_jet(t, X, *this); })
+      model.closed_form_jet(t, X, *this);
+    else
+      evaluate_ad(model, t, X);
+  }
+
+  void evaluate_ad(const Model& model, double t, const Vec<double, n>& X) {
     model.drift(t, X, F);
     model.input_matrix(t, X, B);
     Vec<Outer, n> Y;

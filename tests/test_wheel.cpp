@@ -126,6 +126,31 @@ TEST(WheelDerivatives, JetMatchesFiniteDifferences) {
   }
 }
 
+// The closed-form jet (WheelStateSpace::closed_form_jet, what evaluate
+// uses) against the nested-AD jet, on and off the manifold.
+TEST(WheelDerivatives, ClosedFormJetMatchesNestedAd) {
+  Wheel wheel;
+  const W& m = wheel.state_space();
+  int compared = 0;
+  for (const auto& [label, X] : sample_states(wheel)) {
+    SCOPED_TRACE(label);
+    LieJet<W> closed, ad;
+    closed.evaluate(m, 0.3, X);
+    ad.evaluate_ad(m, 0.3, X);
+    auto near = [](const auto& a, const auto& b, const char* what) {
+      const double scale = 1 + b.cwiseAbs().maxCoeff();
+      EXPECT_LE((a - b).cwiseAbs().maxCoeff(), 1e-13 * scale) << what << "\n" << a << "\nvs AD\n" << b;
+    };
+    near(closed.F, ad.F, "F");
+    near(closed.B, ad.B, "B");
+    near(closed.A, ad.A, "A");
+    near(closed.top, ad.top, "top");
+    near(closed.lower, ad.lower, "lower");
+    ++compared;
+  }
+  EXPECT_GE(compared, 6);
+}
+
 // The declared relative degrees: f1 does not see the reactions directly
 // (L_B f1 = 0) on the tangency manifold, and A is nonsingular there.
 TEST(WheelDerivatives, RelativeDegreesHoldOnTheManifold) {
