@@ -21,6 +21,13 @@
 //
 // Every derivative (Jacobians, the acceleration-level terms, the energy
 // gradient) comes from forward-mode AD here; models write only the functions.
+// A model may also give its holonomic rows' derivatives in closed form (a
+// hand-derived fast path; tests/test_closed_forms.cpp checks each against AD):
+//   template <class Terms> void closed_form_holonomic(double t, const Vec<double,nq>& q,
+//                                                    const Vec<double,nq>* v, Terms& terms) const;
+// setting terms.phi, the first nh rows of terms.A (J = dPhi/dq), terms.phi_t
+// and, when v is given, the first nh entries of terms.gamma (the second
+// derivative of Phi(t + s, q + s v) at s = 0).
 #pragma once
 
 #include <string>
@@ -55,8 +62,22 @@ struct MechanicalTerms {
   VecQ energy_grad_v = VecQ::Zero();
   double energy_rate_free = 0;
 
+  // Forces AD where the model has a closed form (tests compare the two).
+  bool use_ad = false;
+  static constexpr bool has_closed_form() {
+    return requires(const Model& m, const VecQ& q, MechanicalTerms& terms) {
+      m.closed_form_holonomic(0.0, q, &q, terms);
+    };
+  }
+
   // Positions only (projection needs no forces): phi, J (rows 0..nh), phi_t.
   void evaluate_position(const Model& model, double t, const VecQ& q) {
+    if constexpr (has_closed_form()) {
+      if (!use_ad) {
+        model.closed_form_holonomic(t, q, static_cast<const VecQ*>(nullptr), *this);
+        return;
+      }
+    }
     if constexpr (nh > 0) {
       using D = ad::Dual<nq + 1>;
       Vec<D, nq> qd;
@@ -83,20 +104,13 @@ struct MechanicalTerms {
     model.mass(t, q, M);
     model.forces(t, q, v, Q);
     if constexpr (nh > 0) {
-      evaluate_position(model, t, q);
-      // Second derivative of Phi(t + s, q + s v) at s = 0 (hyper-dual):
-      // gamma = d/dt (J v + Phi_t) with v frozen; the first derivative is J v + Phi_t.
-      using D1 = ad::Dual<1>;
-      using H = ad::Nest<D1>;
-      Vec<H, nq> qh;
-      for (int i = 0; i < nq; ++i)
-        qh(i) = H(D1(q(i), Eigen::Matrix<double, 1, 1>(v(i))), Eigen::Matrix<D1, 1, 1>(D1(v(i), Eigen::Matrix<double, 1, 1>(0.0))));
-      const H th(D1(t, Eigen::Matrix<double, 1, 1>(1.0)), Eigen::Matrix<D1, 1, 1>(D1(1.0, Eigen::Matrix<double, 1, 1>(0.0))));
-      Vec<H, nh> f;
-      model.holonomic(th, qh, f);
-      for (int i = 0; i < nh; ++i) {
-        velocity(i) = f(i).value().derivatives()(0);
-        gamma(i) = f(i).derivatives()(0).derivatives()(0);
+      bool closed = false;
+      if constexpr (has_closed_form()) closed = !use_ad;
+      if (closed) {
+        if constexpr (has_closed_form()) model.closed_form_holonomic(t, q, &v, *this);
+        velocity.template head<nh>() = A.template topRows<nh>().lazyProduct(v) + phi_t;
+      } else {
+        holonomic_terms_ad(model, t, q, v);
       }
     }
     if constexpr (nn > 0) nonholonomic_terms(model, t, q, v);
@@ -131,6 +145,25 @@ struct MechanicalTerms {
       }
     }
   };
+
+  // phi, J, phi_t, velocity and gamma of the holonomic rows by AD.
+  void holonomic_terms_ad(const Model& model, double t, const VecQ& q, const VecQ& v) {
+    evaluate_position(model, t, q);
+    // Second derivative of Phi(t + s, q + s v) at s = 0 (hyper-dual):
+    // gamma = d/dt (J v + Phi_t) with v frozen; the first derivative is J v + Phi_t.
+    using D1 = ad::Dual<1>;
+    using H = ad::Nest<D1>;
+    Vec<H, nq> qh;
+    for (int i = 0; i < nq; ++i)
+      qh(i) = H(D1(q(i), Eigen::Matrix<double, 1, 1>(v(i))), Eigen::Matrix<D1, 1, 1>(D1(v(i), Eigen::Matrix<double, 1, 1>(0.0))));
+    const H th(D1(t, Eigen::Matrix<double, 1, 1>(1.0)), Eigen::Matrix<D1, 1, 1>(D1(1.0, Eigen::Matrix<double, 1, 1>(0.0))));
+    Vec<H, nh> f;
+    model.holonomic(th, qh, f);
+    for (int i = 0; i < nh; ++i) {
+      velocity(i) = f(i).value().derivatives()(0);
+      gamma(i) = f(i).derivatives()(0).derivatives()(0);
+    }
+  }
 
   void nonholonomic_terms(const Model& model, double t, const VecQ& q, const VecQ& v) {
     LineDuals d(t, q, v);

@@ -30,6 +30,7 @@
 #include "harness/formulation.hpp"
 #include "harness/problem.hpp"
 #include "methods/affine.hpp"
+#include "problems/trig_rows.hpp"
 
 namespace cstab {
 
@@ -131,6 +132,38 @@ class AndrewsMechanical {
     g(3) = yf + p.e * cophde - p.zt * side - p.ya;
     g(4) = xf - p.zf * coomep - p.u * siep - p.xa;
     g(5) = yf - p.zf * siomep + p.u * coep - p.ya;
+  }
+  // The same rows with their derivatives in closed form (MechanicalTerms).
+  template <class Terms>
+  void closed_form_holonomic(double, const Vec<double, 7>& q, const Vec<double, 7>* v, Terms& terms) const {
+    const auto& p = p_;
+    TrigRows<7, 6> rows(q, v);
+    const auto be = rows.angle(qBeta), beth = rows.angle(qBeta, qTheta), ga = rows.angle(qGamma);
+    const auto phde = rows.angle(qPhi, qDelta), de = rows.angle(qDelta);
+    const auto omep = rows.angle(qOmega, qEpsilon), ep = rows.angle(qEpsilon);
+    for (int r = 0; r < 6; r += 2) {  // xf in rows 0, 2, 4; yf in 1, 3, 5
+      rows.add_cos(r, p.rr, be);
+      rows.add_cos(r, -p.d, beth);
+      rows.add_sin(r + 1, p.rr, be);
+      rows.add_sin(r + 1, -p.d, beth);
+    }
+    rows.add_sin(0, -p.ss, ga);
+    rows.constant(0, -p.xb);
+    rows.add_cos(1, p.ss, ga);
+    rows.constant(1, -p.yb);
+    rows.add_sin(2, -p.e, phde);
+    rows.add_cos(2, -p.zt, de);
+    rows.constant(2, -p.xa);
+    rows.add_cos(3, p.e, phde);
+    rows.add_sin(3, -p.zt, de);
+    rows.constant(3, -p.ya);
+    rows.add_cos(4, -p.zf, omep);
+    rows.add_sin(4, -p.u, ep);
+    rows.constant(4, -p.xa);
+    rows.add_sin(5, -p.zf, omep);
+    rows.add_cos(5, p.u, ep);
+    rows.constant(5, -p.ya);
+    rows.store(terms);
   }
 
   template <class S>

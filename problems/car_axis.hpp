@@ -84,6 +84,28 @@ class CarAxisMechanical {
     phi(1) = dx * dx + dy * dy - p_.L * p_.L;
   }
 
+  // The same rows with their derivatives in closed form (MechanicalTerms):
+  // yb = r sin(w t), xb = sqrt(L^2 - yb^2), so xb' = -yb yb' / xb and
+  // xb'' = -(xb'^2 + yb'^2 + yb yb'') / xb.
+  template <class Terms>
+  void closed_form_holonomic(double t, const Vec<double, 4>& q, const Vec<double, 4>* v, Terms& terms) const {
+    double xb, yb;
+    bump(t, xb, yb);
+    const double yb1 = p_.r * p_.w * std::cos(p_.w * t), xb1 = -yb * yb1 / xb;
+    const double dx = q(qXL) - q(qXR), dy = q(qYL) - q(qYR);
+    terms.phi(0) = xb * q(qXL) + yb * q(qYL);
+    terms.phi(1) = dx * dx + dy * dy - p_.L * p_.L;
+    terms.A.template topRows<2>() << xb, yb, 0, 0, 2 * dx, 2 * dy, -2 * dx, -2 * dy;
+    terms.phi_t(0) = xb1 * q(qXL) + yb1 * q(qYL);
+    terms.phi_t(1) = 0;
+    if (v) {
+      const double yb2 = -p_.w * p_.w * yb, xb2 = -(xb1 * xb1 + yb1 * yb1 + yb * yb2) / xb;
+      const double dvx = (*v)(qXL) - (*v)(qXR), dvy = (*v)(qYL) - (*v)(qYR);
+      terms.gamma(0) = xb2 * q(qXL) + yb2 * q(qYL) + 2 * (xb1 * (*v)(qXL) + yb1 * (*v)(qYL));
+      terms.gamma(1) = 2 * (dvx * dvx + dvy * dvy);
+    }
+  }
+
   template <class S>
   void bump(const S& t, S& xb, S& yb) const {
     using std::sin;

@@ -38,6 +38,7 @@
 #include "harness/formulation.hpp"
 #include "harness/problem.hpp"
 #include "methods/affine.hpp"
+#include "problems/trig_rows.hpp"
 
 namespace cstab {
 
@@ -109,6 +110,18 @@ class SliderCrankMechanical {
     using std::sin;
     phi(0) = q(qX) - cos(q(qP)) - p_.a * cos(q(qQ));
     phi(1) = -sin(q(qP)) - p_.a * sin(q(qQ));
+  }
+  // The same rows with their derivatives in closed form (MechanicalTerms).
+  template <class Terms>
+  void closed_form_holonomic(double, const Vec<double, 3>& q, const Vec<double, 3>* v, Terms& terms) const {
+    TrigRows<3, 2> rows(q, v);
+    const auto P = rows.angle(qP), Q = rows.angle(qQ);
+    rows.linear(0, 1.0, qX);
+    rows.add_cos(0, -1.0, P);
+    rows.add_cos(0, -p_.a, Q);
+    rows.add_sin(1, -1.0, P);
+    rows.add_sin(1, -p_.a, Q);
+    rows.store(terms);
   }
 
  private:
