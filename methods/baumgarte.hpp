@@ -41,13 +41,12 @@ class BaumgarteFormulation final : public MechanicalFormulationBase<Model> {
                          std::to_string(solver_.pivot_ratio()) + ") at t = " + std::to_string(t);
         return false;
       }
-      const VecQ a = solver_.free_acceleration(terms_.Q);
-      Vec<double, nc> rows = terms_.A.lazyProduct(a) + terms_.gamma;  // A a + gamma + stab = 0
+      Vec<double, nc> g = terms_.gamma;  // A a + g = 0 with g = gamma + stab
       if constexpr (nh > 0)
-        rows.template head<nh>() += 2 * alpha_ * terms_.velocity.template head<nh>() + beta_ * beta_ * terms_.phi;
+        g.template head<nh>() += 2 * alpha_ * terms_.velocity.template head<nh>() + beta_ * beta_ * terms_.phi;
       if constexpr (nc > nh)
-        rows.template tail<nc - nh>() += gamma_ * terms_.velocity.template tail<nc - nh>();
-      vmap<nq>(dydt + nq) = a + solver_.reaction_acceleration(solver_.multipliers(-rows));
+        g.template tail<nc - nh>() += gamma_ * terms_.velocity.template tail<nc - nh>();
+      vmap<nq>(dydt + nq) = solver_.accelerations(terms_.Q, g);
     }
     return true;
   }

@@ -42,11 +42,11 @@ class IndexOneFormulation : public MechanicalFormulationBase<Model> {
       // rows fall back to the complete orthogonal decomposition.
       const auto status = schur_.factor(terms_.M, terms_.A, 1e-10);
       if (status == SchurSolver<nq, nc>::Status::kMassNotPd) return mass_failure(t);
-      a = schur_.free_acceleration(terms_.Q);
-      const VecC r = -terms_.gamma - terms_.A.lazyProduct(a);
       if (status == SchurSolver<nq, nc>::Status::kOk) {
-        a += schur_.reaction_acceleration(schur_.multipliers(r));
+        a = schur_.accelerations(terms_.Q, terms_.gamma);
       } else {
+        a = schur_.free_acceleration(terms_.Q);
+        const VecC r = -terms_.gamma - terms_.A.lazyProduct(a);
         if (!mass_.factor(terms_.M)) return mass_failure(t);
         pinv_.set_rows(mass_, terms_.A);
         a += pinv_.correction(r);

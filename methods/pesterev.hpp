@@ -124,15 +124,14 @@ class PesterevMechanicalFormulation final : public MechanicalFormulationBase<Mod
   bool rhs(double t, const double* y, double* dydt) override {
     const VecQ q = vmap<nq>(y), v = vmap<nq>(y + nq);
     if (build(t, q, v, 1e-14) != Solver::Status::kOk) return false;
-    const VecQ a = solver_.free_acceleration(terms_.Q);
-    Vec<double, nc> phi = terms_.A.lazyProduct(a) + terms_.gamma;
+    // A a + g = 0 with g = gamma + the feedback terms.
+    Vec<double, nc> g = terms_.gamma;
     for (int i = 0; i < nc; ++i) {
       const double l = lambda_(i);
-      phi(i) += i < nh ? 2 * l * terms_.velocity(i) + l * l * terms_.phi(i) : l * terms_.velocity(i);
+      g(i) += i < nh ? 2 * l * terms_.velocity(i) + l * l * terms_.phi(i) : l * terms_.velocity(i);
     }
-    const Vec<double, nc> N = solver_.multipliers(-phi);
     vmap<nq>(dydt) = v;
-    vmap<nq>(dydt + nq) = a + solver_.reaction_acceleration(N);
+    vmap<nq>(dydt + nq) = solver_.accelerations(terms_.Q, g);
     return true;
   }
 

@@ -127,6 +127,19 @@ class SchurSolver {
     if (!schur_.factor(S_) || !(schur_.pivot_ratio() > min_pivot_ratio)) return Status::kSingular;
     return Status::kOk;
   }
+  // a with M a = Q + A^T N, A a + g = 0 (and N, if asked): with y = L^-1 Q,
+  // A a_free = C y, so S N = -(C y + g) and a = L^-T (y + C^T N): one
+  // forward and one back substitution with L (free_acceleration, then
+  // reaction_acceleration, take three).
+  VecQ accelerations(const VecQ& Q, const VecC& g, VecC* multipliers_out = nullptr) const {
+    VecQ y = Q;
+    mass_.solve_lower_in_place(y);
+    const VecC N = schur_.solve(-(Ct_.transpose().lazyProduct(y) + g));
+    y.noalias() += Ct_.lazyProduct(N);
+    mass_.solve_upper_in_place(y);
+    if (multipliers_out) *multipliers_out = N;
+    return y;
+  }
   // a_free = M^-1 Q
   VecQ free_acceleration(const VecQ& Q) const { return mass_.solve(Q); }
   // N with S N = r

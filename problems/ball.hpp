@@ -155,6 +155,29 @@ class BallMechanical {
       }
   }
 
+  // The same rows with their derivatives in closed form (MechanicalTerms):
+  // phi_k = e_i . e_j - delta_ij has gradient e_j in e_i and e_i in e_j, and
+  // second derivative along v 2 (e_i' . e_j'); rho - rc is linear.
+  template <class Terms>
+  void closed_form_holonomic(double, const Vec<double, 12>& q, const Vec<double, 12>* v, Terms& terms) const {
+    auto J = terms.A.template topRows<7>();
+    J.setZero();
+    terms.phi_t.setZero();
+    terms.phi(0) = q(qRHO) - p_.rc();
+    J(0, qRHO) = 1.0;
+    if (v) terms.gamma(0) = 0.0;
+    int k = 1;
+    for (int i = 0; i < 3; ++i)
+      for (int j = i; j < 3; ++j) {
+        const auto ei = q.template segment<3>(3 + 3 * i), ej = q.template segment<3>(3 + 3 * j);
+        terms.phi(k) = ei.dot(ej) - (i == j ? 1.0 : 0.0);
+        J.template block<1, 3>(k, 3 + 3 * i) += ej.transpose();
+        J.template block<1, 3>(k, 3 + 3 * j) += ei.transpose();
+        if (v) terms.gamma(k) = 2.0 * v->template segment<3>(3 + 3 * i).dot(v->template segment<3>(3 + 3 * j));
+        ++k;
+      }
+  }
+
   template <class S>
   void nonholonomic(const S&, const Vec<S, 12>& q, const Vec<S, 12>& v, Vec<S, 2>& psi) const {
     using namespace ball_detail;

@@ -83,9 +83,11 @@ TEST(FailingRuns, AbsurdGainIsAResidualBlowUp) {
 
 // Baumgarte with gains far beyond explicit Euler's stability, and the
 // residual check out of the way: the state itself overflows to inf/NaN and
-// is caught as such.
+// is caught as such. (On the slider-crank, whose constraint rows keep full
+// rank everywhere; on the wheel the exploding state first makes the
+// reaction matrix singular, which is recorded as "failed".)
 TEST(FailingRuns, AbsurdGainWithoutBlowupLimitIsANonFiniteState) {
-  const RunResult r = run("wheel", "baumgarte", "euler", 1e-2, 1, {{"alpha", "1e5"}, {"beta", "1e5"}}, 1e308);
+  const RunResult r = run("slider-crank", "baumgarte", "euler", 1e-2, 1, {{"alpha", "1e5"}, {"beta", "1e5"}}, 1e308);
   expect_recorded(r, "diverged", "non-finite");
 }
 

@@ -87,6 +87,13 @@ void check_schur() {
     EXPECT_LT((a - x.template head<NQ>()).norm(), 1e-9 * (1 + x.norm()));
     EXPECT_LT((N - x.template tail<NC>()).norm(), 1e-9 * (1 + x.norm()));
     EXPECT_LT((s.schur() - A * M.inverse() * A.transpose()).norm(), 1e-10 * s.schur().norm());
+    // The two-substitution path the methods use.
+    Eigen::Matrix<double, NC, 1> N2;
+    const Eigen::Matrix<double, NQ, 1> a2 = s.accelerations(Q, g, &N2);
+    EXPECT_LT((a2 - x.template head<NQ>()).norm(), 1e-9 * (1 + x.norm()));
+    EXPECT_LT((N2 - x.template tail<NC>()).norm(), 1e-9 * (1 + x.norm()));
+    EXPECT_LT((M * a2 - Q - A.transpose() * N2).norm(), 1e-9 * (1 + Q.norm()));
+    EXPECT_LT((A * a2 + g).norm(), 1e-9 * (1 + g.norm()));
   }
 }
 
