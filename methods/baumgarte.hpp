@@ -8,6 +8,7 @@
 // complement (A M^-1 A^T) lambda = -(A M^-1 Q + gamma_acc + stab).
 #pragma once
 
+#include "harness/format.hpp"
 #include "methods/mechanical_method.hpp"
 #include "methods/small_linalg.hpp"
 
@@ -38,7 +39,7 @@ class BaumgarteFormulation final : public MechanicalFormulationBase<Model> {
       if (status == SchurSolver<nq, nc>::Status::kMassNotPd) return mass_failure(t);
       if (status != SchurSolver<nq, nc>::Status::kOk) {
         this->failure_ = "constraint matrix A M^-1 A^T singular (pivot ratio " +
-                         std::to_string(solver_.pivot_ratio()) + ") at t = " + std::to_string(t);
+                         format_3g(solver_.pivot_ratio()) + ") at t = " + std::to_string(t);
         return false;
       }
       Vec<double, nc> g = terms_.gamma;  // A a + g = 0 with g = gamma + stab

@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "harness/format.hpp"
 #include "harness/formulation.hpp"
 #include "harness/params.hpp"
 #include "methods/affine.hpp"
@@ -62,7 +63,7 @@ class PesterevFormulation final : public AffineFormulationBase<Model> {
     lu_.compute(jet_.A);
     if (!(lu_.rcond() > 1e-12))
       throw UsageError("pesterev: declared relative degrees do not hold at the initial state "
-                       "(A(X0) singular, rcond " + std::to_string(lu_.rcond()) + ")");
+                       "(A(X0) singular, rcond " + format_3g(lu_.rcond()) + ")");
   }
 
   bool rhs(double t, const double* y, double* dydt) override {
@@ -75,7 +76,7 @@ class PesterevFormulation final : public AffineFormulationBase<Model> {
     // 1-norm rcond estimate cost a third of this right-hand side (README, Speed).
     const double ratio = pesterev_detail::lu_pivot_ratio(lu_);
     if (!(ratio > 1e-14)) {
-      this->failure_ = "reaction matrix A(X) singular (LU pivot ratio " + std::to_string(ratio) + ") at t = " +
+      this->failure_ = "reaction matrix A(X) singular (LU pivot ratio " + format_3g(ratio) + ") at t = " +
                  std::to_string(t);
       return false;
     }
@@ -118,7 +119,7 @@ class PesterevMechanicalFormulation final : public MechanicalFormulationBase<Mod
     model.initial_state(q, v);
     if (build(0.0, q, v, 1e-12) != Solver::Status::kOk)
       throw UsageError("pesterev: A(X0) = A M^-1 A^T is singular at the initial state (pivot ratio " +
-                       std::to_string(solver_.pivot_ratio()) + "): redundant constraints; use braun-goldfarb or projection");
+                       format_3g(solver_.pivot_ratio()) + "): redundant constraints; use braun-goldfarb or projection");
   }
 
   bool rhs(double t, const double* y, double* dydt) override {
@@ -153,7 +154,7 @@ class PesterevMechanicalFormulation final : public MechanicalFormulationBase<Mod
       this->failure_ = "mass matrix not positive definite at t = " + std::to_string(t);
     else if (status == Solver::Status::kSingular)
       this->failure_ = "reaction matrix A(X) = A M^-1 A^T singular (pivot ratio " +
-                       std::to_string(solver_.pivot_ratio()) + ") at t = " + std::to_string(t);
+                       format_3g(solver_.pivot_ratio()) + ") at t = " + std::to_string(t);
     return status;
   }
 
