@@ -27,7 +27,12 @@
 //                                                    const Vec<double,nq>* v, Terms& terms) const;
 // setting terms.phi, the first nh rows of terms.A (J = dPhi/dq), terms.phi_t
 // and, when v is given, the first nh entries of terms.gamma (the second
-// derivative of Phi(t + s, q + s v) at s = 0).
+// derivative of Phi(t + s, q + s v) at s = 0). Likewise for the
+// non-holonomic rows,
+//   template <class Terms> void closed_form_nonholonomic(double t, const Vec<double,nq>& q,
+//                                                       const Vec<double,nq>& v, Terms& terms) const;
+// setting the last nn entries of terms.velocity (Psi), rows nh.. of terms.A
+// (G = dPsi/dv) and the last nn entries of terms.gamma (dPsi/dq v + dPsi/dt).
 #pragma once
 
 #include <string>
@@ -67,6 +72,11 @@ struct MechanicalTerms {
   static constexpr bool has_closed_form() {
     return requires(const Model& m, const VecQ& q, MechanicalTerms& terms) {
       m.closed_form_holonomic(0.0, q, &q, terms);
+    };
+  }
+  static constexpr bool has_closed_form_nonholonomic() {
+    return requires(const Model& m, const VecQ& q, MechanicalTerms& terms) {
+      m.closed_form_nonholonomic(0.0, q, q, terms);
     };
   }
 
@@ -166,6 +176,12 @@ struct MechanicalTerms {
   }
 
   void nonholonomic_terms(const Model& model, double t, const VecQ& q, const VecQ& v) {
+    if constexpr (has_closed_form_nonholonomic()) {
+      if (!use_ad) {
+        model.closed_form_nonholonomic(t, q, v, *this);
+        return;
+      }
+    }
     LineDuals d(t, q, v);
     const auto& [td, qd, vd] = d;
     using D = LineDual;

@@ -197,6 +197,45 @@ class BallMechanical {
     psi(1) = rho * cos(q(qALPHA)) * v(qBETA) + dot3(eb, vpc);
   }
 
+  // The rolling rows in closed form (MechanicalTerms). With u_i = e_i',
+  // w_i = r (e_i . e_rho) and v_P^C = sum_i w_i u_i: G has rho (alpha'),
+  // rho cos(alpha) (beta') and w_i e_alpha / w_i e_beta (u_i). Along the
+  // motion e_rho' = e_alpha alpha' + cos(alpha) e_beta beta',
+  // e_alpha' = -e_rho alpha' - sin(alpha) e_beta beta',
+  // e_beta' = -(cos beta, sin beta, 0) beta', and
+  // (v_P^C)' = sum_i r (u_i . e_rho + e_i . e_rho') u_i with u frozen.
+  template <class Terms>
+  void closed_form_nonholonomic(double, const Vec<double, 12>& q, const Vec<double, 12>& v, Terms& terms) const {
+    using namespace ball_detail;
+    V3<double> er, ea, eb;
+    basis(q(qALPHA), q(qBETA), er, ea, eb);
+    const double ca = std::cos(q(qALPHA)), sa = std::sin(q(qALPHA));
+    const double cb = std::cos(q(qBETA)), sb = std::sin(q(qBETA));
+    const double rho = q(qRHO), rd = v(qRHO), ad = v(qALPHA), bd = v(qBETA);
+    const V3<double> er_dot = ea * ad + ca * bd * eb;
+    const V3<double> ea_dot = -er * ad - sa * bd * eb;
+    const V3<double> eb_dot(-cb * bd, -sb * bd, 0.0);
+    V3<double> vpc = V3<double>::Zero(), vpc_dot = V3<double>::Zero();
+    auto G = terms.A.template bottomRows<2>();
+    G.setZero();
+    G(0, qALPHA) = rho;
+    G(1, qBETA) = rho * ca;
+    for (int i = 0; i < 3; ++i) {
+      const int k = 3 + 3 * i;
+      const auto e = q.template segment<3>(k);
+      const auto u = v.template segment<3>(k);
+      const double w = p_.r * e.dot(er);
+      vpc += w * u;
+      vpc_dot += p_.r * (u.dot(er) + e.dot(er_dot)) * u;
+      G.template block<1, 3>(0, k) = w * ea.transpose();
+      G.template block<1, 3>(1, k) = w * eb.transpose();
+    }
+    terms.velocity(7) = rho * ad + ea.dot(vpc);
+    terms.velocity(8) = rho * ca * bd + eb.dot(vpc);
+    terms.gamma(7) = rd * ad + ea_dot.dot(vpc) + ea.dot(vpc_dot);
+    terms.gamma(8) = (rd * ca - rho * sa * ad) * bd + eb_dot.dot(vpc) + eb.dot(vpc_dot);
+  }
+
   template <class S>
   S energy(const S&, const Vec<S, 12>& q, const Vec<S, 12>& v) const {
     using std::cos;

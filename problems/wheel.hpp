@@ -21,6 +21,7 @@
 #include <map>
 #include <memory>
 #include <mutex>
+#include <type_traits>
 #include <vector>
 
 #include "harness/formulation.hpp"
@@ -261,6 +262,44 @@ class WheelMechanical {
     const S d1 = p_.dp(s);
     phi(0) = ((q(qX) - s) * (-d1) + (q(qZ) - p_.p(s))) / sqrt(1.0 + d1 * d1) - p_.r;
   }
+  // The distance row with its derivatives in closed form (MechanicalTerms),
+  // from one contact solve in double instead of two on AD types. With
+  // n = (-p', 1)/w the unit normal at the contact s (w = sqrt(1 + p'^2)):
+  // J = [n, 0, 0] (the distance is stationary in s at the foot), and with
+  // ds/d(x, z) = (1, p')/g_s, g_s = 1 + p'^2 + (p - z) p'', and
+  // dn/ds = p''/w^3 (-1, -p'), the curvature term is
+  //   gamma = v^T (dn/ds ds/d(x, z)) v = -p'' (xdot + p' zdot)^2 / (w^3 g_s).
+  template <class Terms>
+  void closed_form_holonomic(double, const Vec<double, 4>& q, const Vec<double, 4>* v, Terms& terms) const {
+    const double s = contact(q(qX), q(qZ));
+    const double p0 = p_.p(s), d1 = p_.dp(s), d2 = p_.ddp(s);
+    const double w = std::sqrt(1 + d1 * d1);
+    terms.phi(0) = ((q(qX) - s) * (-d1) + (q(qZ) - p0)) / w - p_.r;
+    terms.A.template topRows<1>() << -d1 / w, 1 / w, 0, 0;
+    terms.phi_t(0) = 0;
+    if (v) {
+      const double gs = 1 + d1 * d1 + (p0 - q(qZ)) * d2;
+      const double along = (*v)(qX) + d1 * (*v)(qZ);
+      terms.gamma(0) = -d2 * along * along / (w * w * w * gs);
+    }
+  }
+
+  // The rolling row in closed form: G = [1/w, p'/w, r, 0], and along the
+  // motion d/ds[(xdot + p' zdot)/w] = p'' (zdot - p' xdot)/w^3 with
+  // ds/dt = (xdot + p' zdot)/g_s, so
+  //   dPsi/dq v = p'' (zdot - p' xdot)(xdot + p' zdot) / (w^3 g_s).
+  template <class Terms>
+  void closed_form_nonholonomic(double, const Vec<double, 4>& q, const Vec<double, 4>& v, Terms& terms) const {
+    const double s = contact(q(qX), q(qZ));
+    const double p0 = p_.p(s), d1 = p_.dp(s), d2 = p_.ddp(s);
+    const double w = std::sqrt(1 + d1 * d1);
+    const double along = v(qX) + d1 * v(qZ);
+    terms.velocity(1) = along / w + p_.r * v(qTH);
+    terms.A.template bottomRows<1>() << 1 / w, d1 / w, p_.r, 0;
+    const double gs = 1 + d1 * d1 + (p0 - q(qZ)) * d2;
+    terms.gamma(1) = d2 * (v(qZ) - d1 * v(qX)) * along / (w * w * w * gs);
+  }
+
   template <class S>
   void nonholonomic(const S&, const Vec<S, 4>& q, const Vec<S, 4>& v, Vec<S, 1>& psi) const {
     using std::sqrt;
@@ -300,6 +339,9 @@ class WheelMechanical {
       const double ds = g / dg;
       s -= ds;
       if (std::abs(ds) < 1e-15) break;
+    }
+    if constexpr (std::is_same_v<S, double>) {
+      return s;  // converged: the steps below only carry AD derivatives
     }
     S sa(s);
     for (int k = 0; k < 2; ++k) {

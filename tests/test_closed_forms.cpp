@@ -11,6 +11,7 @@
 #include "problems/ball.hpp"
 #include "problems/car_axis.hpp"
 #include "problems/slider_crank.hpp"
+#include "problems/wheel_sharp.hpp"
 
 namespace cstab {
 namespace {
@@ -59,7 +60,17 @@ void expect_closed_form_matches_ad(const Model& model) {
 
 TEST(ClosedFormHolonomic, SliderCrankMatchesAd) { expect_closed_form_matches_ad(SliderCrank().mechanical()); }
 TEST(ClosedFormHolonomic, AndrewsMatchesAd) { expect_closed_form_matches_ad(Andrews().mechanical()); }
-TEST(ClosedFormHolonomic, BallMatchesAd) { expect_closed_form_matches_ad(Ball().mechanical()); }
+TEST(ClosedFormHolonomic, BallMatchesAd) {
+  static_assert(MechanicalTerms<BallMechanical>::has_closed_form_nonholonomic());
+  expect_closed_form_matches_ad(Ball().mechanical());
+}
+TEST(ClosedFormHolonomic, WheelMatchesAd) {
+  // The wheel gives its rolling (non-holonomic) row in closed form too; the
+  // comparison covers every row of A, gamma and the velocity residual.
+  static_assert(MechanicalTerms<WheelMechanical>::has_closed_form_nonholonomic());
+  expect_closed_form_matches_ad(Wheel().mechanical());
+}
+TEST(ClosedFormHolonomic, WheelSharpMatchesAd) { expect_closed_form_matches_ad(WheelSharp().mechanical()); }
 TEST(ClosedFormHolonomic, CarAxisMatchesAd) { expect_closed_form_matches_ad(CarAxis().mechanical()); }
 
 // The AD path is really a different computation: a deliberately wrong
