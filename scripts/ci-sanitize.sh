@@ -1,0 +1,27 @@
+#!/usr/bin/env bash
+# CI's sanitizer step (issue 9): `scripts/sanitize.sh` (ASan + UBSan build of
+# the whole suite) within what is left of CI's time budget.
+#   usage: scripts/ci-sanitize.sh END   (END: the budget's end, seconds since the epoch)
+# A sanitizer finding or a failing test fails the step (each failing test
+# gets one retry, so a timing flake under the instrumented build's load does
+# not; a real finding fails both times). If the budget runs out first, the
+# step stops the build or the tests and says so, and does not fail: the
+# release tests before it are CI's gate, the sanitized run is the extra.
+set -uo pipefail
+cd "$(dirname "$0")/.."
+end=${1:?usage: scripts/ci-sanitize.sh END_EPOCH_SECONDS}
+min_left=${CSTAB_CI_SANITIZE_MIN:-900}
+left=$((end - $(date +%s)))
+if ((left < min_left)); then
+  echo "ci-sanitize: skipped: ${left} s left of the CI time budget (it needs at least ${min_left} s)"
+  exit 0
+fi
+echo "ci-sanitize: ASan + UBSan build and tests, at most ${left} s"
+timeout --kill-after=30 "$left" bash scripts/sanitize.sh --repeat until-pass:2
+rc=$?
+if ((rc == 124 || rc == 137)); then
+  echo "ci-sanitize: stopped at the CI time budget after ${left} s: the sanitized run is incomplete (not counted as a failure)"
+  exit 0
+fi
+((rc == 0)) && echo "ci-sanitize: passed"
+exit $rc
