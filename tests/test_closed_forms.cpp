@@ -17,6 +17,7 @@
 #include "problems/car_axis.hpp"
 #include "problems/slider_crank.hpp"
 #include "problems/wheel_sharp.hpp"
+#include "tests/expect_close.hpp"
 
 namespace cstab {
 namespace {
@@ -42,22 +43,18 @@ void expect_closed_form_matches_ad(const Model& model) {
     ad.use_ad = true;
     closed.evaluate(model, t, q, v, false);
     ad.evaluate(model, t, q, v, false);
-    auto near = [](const auto& a, const auto& b, const char* what) {
-      const double scale = 1 + b.cwiseAbs().maxCoeff();
-      EXPECT_LE((a - b).cwiseAbs().maxCoeff(), 1e-13 * scale) << what << "\n" << a << "\nvs AD\n" << b;
-    };
-    near(closed.phi, ad.phi, "phi");
-    near(closed.A, ad.A, "J");
-    near(closed.phi_t, ad.phi_t, "phi_t");
-    near(closed.velocity, ad.velocity, "J v + phi_t");
-    near(closed.gamma, ad.gamma, "gamma");
+    cstab::testing::expect_matches_ad(closed.phi, ad.phi, "phi");
+    cstab::testing::expect_matches_ad(closed.A, ad.A, "J");
+    cstab::testing::expect_matches_ad(closed.phi_t, ad.phi_t, "phi_t");
+    cstab::testing::expect_matches_ad(closed.velocity, ad.velocity, "J v + phi_t");
+    cstab::testing::expect_matches_ad(closed.gamma, ad.gamma, "gamma");
     // Positions only (projection's path): no v, same phi, J, phi_t.
     Terms pos;
     pos.evaluate_position(model, t, q);
-    near(pos.phi, ad.phi, "phi (positions only)");
+    cstab::testing::expect_matches_ad(pos.phi, ad.phi, "phi (positions only)");
     // (evaluate_position sets the holonomic rows of A only)
-    near(pos.A.template topRows<Model::kHolonomic>(), ad.A.template topRows<Model::kHolonomic>(), "J (positions only)");
-    near(pos.phi_t, ad.phi_t, "phi_t (positions only)");
+    cstab::testing::expect_matches_ad(pos.A.template topRows<Model::kHolonomic>(), ad.A.template topRows<Model::kHolonomic>(), "J (positions only)");
+    cstab::testing::expect_matches_ad(pos.phi_t, ad.phi_t, "phi_t (positions only)");
     ++compared;
   }
   EXPECT_EQ(compared, 6);

@@ -20,6 +20,7 @@
 #include "methods/pesterev.hpp"
 #include "problems/registry.hpp"
 #include "problems/wheel.hpp"
+#include "tests/expect_close.hpp"
 
 namespace cstab {
 namespace {
@@ -137,15 +138,11 @@ TEST(WheelDerivatives, ClosedFormJetMatchesNestedAd) {
     LieJet<W> closed, ad;
     closed.evaluate(m, 0.3, X);
     ad.evaluate_ad(m, 0.3, X);
-    auto near = [](const auto& a, const auto& b, const char* what) {
-      const double scale = 1 + b.cwiseAbs().maxCoeff();
-      EXPECT_LE((a - b).cwiseAbs().maxCoeff(), 1e-13 * scale) << what << "\n" << a << "\nvs AD\n" << b;
-    };
-    near(closed.F, ad.F, "F");
-    near(closed.B, ad.B, "B");
-    near(closed.A, ad.A, "A");
-    near(closed.top, ad.top, "top");
-    near(closed.lower, ad.lower, "lower");
+    cstab::testing::expect_matches_ad(closed.F, ad.F, "F");
+    cstab::testing::expect_matches_ad(closed.B, ad.B, "B");
+    cstab::testing::expect_matches_ad(closed.A, ad.A, "A");
+    cstab::testing::expect_matches_ad(closed.top, ad.top, "top");
+    cstab::testing::expect_matches_ad(closed.lower, ad.lower, "lower");
     ++compared;
   }
   EXPECT_GE(compared, 6);
