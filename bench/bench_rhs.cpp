@@ -14,9 +14,9 @@
 #include <string>
 #include <vector>
 
-#include "harness/formulation.hpp"
+#include "core/formulation.hpp"
 #include "harness/integrator.hpp"
-#include "methods/dispatch.hpp"
+#include "methods/pair.hpp"
 #include "problems/registry.hpp"
 
 namespace {

@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "harness/params.hpp"
+#include "core/params.hpp"
 
 namespace cstab::cli {
 

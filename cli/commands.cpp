@@ -7,10 +7,10 @@
 #include "cli/gate_command.hpp"
 #include "cli/stability_command.hpp"
 #include "cli/matrix_commands.hpp"
-#include "harness/format.hpp"
+#include "core/format.hpp"
 #include "harness/integrator.hpp"
 #include "harness/run.hpp"
-#include "methods/dispatch.hpp"
+#include "methods/pair.hpp"
 #include "problems/registry.hpp"
 
 namespace cstab::cli {

@@ -11,9 +11,9 @@
 #include <iostream>
 
 #include "cli/args.hpp"
-#include "harness/csv.hpp"
-#include "harness/format.hpp"
-#include "harness/gate.hpp"
+#include "io/csv.hpp"
+#include "core/format.hpp"
+#include "gate/gate.hpp"
 
 namespace cstab::cli {
 

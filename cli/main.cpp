@@ -12,8 +12,8 @@
 #include <vector>
 
 #include "cli/commands.hpp"
-#include "harness/csv.hpp"
-#include "harness/params.hpp"
+#include "io/csv.hpp"
+#include "core/params.hpp"
 
 namespace {
 

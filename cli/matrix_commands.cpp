@@ -8,11 +8,11 @@
 #include <thread>
 
 #include "cli/args.hpp"
-#include "harness/csv.hpp"
-#include "harness/matrix.hpp"
-#include "harness/provenance.hpp"
-#include "harness/report.hpp"
-#include "methods/dispatch.hpp"
+#include "io/csv.hpp"
+#include "matrix/matrix.hpp"
+#include "matrix/provenance.hpp"
+#include "report/report.hpp"
+#include "methods/pair.hpp"
 #include "problems/registry.hpp"
 
 namespace cstab::cli {

@@ -11,8 +11,8 @@
 #include <iostream>
 
 #include "cli/args.hpp"
-#include "harness/csv.hpp"
-#include "harness/format.hpp"
+#include "io/csv.hpp"
+#include "core/format.hpp"
 #include "harness/integrator.hpp"
 #include "harness/stability.hpp"
 #include "problems/registry.hpp"

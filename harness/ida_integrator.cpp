@@ -23,9 +23,9 @@
 #include <memory>
 #include <type_traits>
 
-#include "format.hpp"
-#include "integrator.hpp"
-#include "params.hpp"
+#include "core/format.hpp"
+#include "harness/integrator.hpp"
+#include "core/params.hpp"
 
 namespace cstab {
 

@@ -1,4 +1,4 @@
-#include "integrator.hpp"
+#include "harness/integrator.hpp"
 
 #include <gsl/gsl_errno.h>
 #include <gsl/gsl_odeiv2.h>
@@ -8,8 +8,8 @@
 #include <cmath>
 #include <cstring>
 
-#include "format.hpp"
-#include "params.hpp"
+#include "core/format.hpp"
+#include "core/params.hpp"
 
 namespace cstab {
 

@@ -10,7 +10,7 @@
 #include <utility>
 #include <vector>
 
-#include "formulation.hpp"
+#include "core/formulation.hpp"
 
 namespace cstab {
 

@@ -1,12 +1,12 @@
-#include "run.hpp"
+#include "harness/run.hpp"
 
 #include <algorithm>
 #include <chrono>
 #include <filesystem>
 #include <memory>
 
-#include "csv.hpp"
-#include "format.hpp"
+#include "io/csv.hpp"
+#include "core/format.hpp"
 
 namespace cstab {
 

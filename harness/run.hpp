@@ -10,8 +10,8 @@
 #include <utility>
 #include <vector>
 
-#include "integrator.hpp"
-#include "problem.hpp"
+#include "harness/integrator.hpp"
+#include "core/problem.hpp"
 
 namespace cstab {
 

@@ -5,7 +5,7 @@
 #include <cmath>
 #include <complex>
 
-#include "harness/format.hpp"
+#include "core/format.hpp"
 #include "harness/integrator.hpp"
 
 namespace cstab {

@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-#include "harness/problem.hpp"
+#include "core/problem.hpp"
 #include "harness/run.hpp"
 
 namespace cstab {

@@ -22,23 +22,12 @@
 #include <string>
 #include <vector>
 
-#include "harness/autodiff.hpp"
-#include "harness/formulation.hpp"
+#include "core/autodiff.hpp"
+#include "core/formulation.hpp"
+#include "core/vec.hpp"
+#include "linalg/dense.hpp"
 
 namespace cstab {
-
-template <class S, int N>
-using Vec = Eigen::Matrix<S, N, 1>;
-
-// Fixed-size views of raw state arrays.
-template <int N>
-Eigen::Map<Vec<double, N>> vmap(double* p) {
-  return Eigen::Map<Vec<double, N>>(p);
-}
-template <int N>
-Eigen::Map<const Vec<double, N>> vmap(const double* p) {
-  return Eigen::Map<const Vec<double, N>>(p);
-}
 
 template <class Model>
 class LieJet {
@@ -144,12 +133,5 @@ class AffineFormulationBase : public Formulation {
   std::string failure_;
 };
 
-// 2-norm condition number of a small square matrix (infinite if singular).
-template <int K>
-double condition_number_of(const Eigen::Matrix<double, K, K>& A) {
-  Eigen::JacobiSVD<Eigen::Matrix<double, K, K>> svd(A);
-  const auto& s = svd.singularValues();
-  return s(K - 1) > 0 ? s(0) / s(K - 1) : std::numeric_limits<double>::infinity();
-}
 
 }  // namespace cstab

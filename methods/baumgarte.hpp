@@ -8,9 +8,9 @@
 // complement (A M^-1 A^T) lambda = -(A M^-1 Q + gamma_acc + stab).
 #pragma once
 
-#include "harness/format.hpp"
+#include "core/format.hpp"
 #include "methods/mechanical_method.hpp"
-#include "methods/small_linalg.hpp"
+#include "linalg/small_linalg.hpp"
 
 namespace cstab {
 

@@ -14,7 +14,7 @@
 #pragma once
 
 #include "methods/mechanical_method.hpp"
-#include "methods/weighted_pinv.hpp"
+#include "linalg/weighted_pinv.hpp"
 
 namespace cstab {
 

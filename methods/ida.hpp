@@ -31,7 +31,8 @@
 #include <cmath>
 
 #include "methods/mechanical_method.hpp"
-#include "methods/weighted_pinv.hpp"
+#include "linalg/dense.hpp"
+#include "linalg/weighted_pinv.hpp"
 
 namespace cstab {
 
@@ -82,12 +83,15 @@ class MechanicalDaeFormulation final : public MechanicalFormulationBase<Model>, 
       K.template bottomLeftCorner<nc, nq>() = terms.A;
       b.template tail<nc>() = -terms.gamma;
     }
+    // The solve stays fixed-size (its result seeds IDA, whose step sequence
+    // is sensitive to the last bit); the condition estimate is the cold
+    // dynamic-size one.
     const Eigen::PartialPivLU<Eigen::Matrix<double, nk, nk>> lu(K);
     Vec<double, nk> x = lu.solve(b);
-    if (!(lu.rcond() > 1e-15) || !x.allFinite()) {
+    if (!(linalg::lu_rcond_of(K) > 1e-15) || !x.allFinite()) {
       // Leave the multipliers to IDACalcIC.
       x.setZero();
-      x.template head<nq>() = terms.M.ldlt().solve(terms.Q);
+      linalg::ldlt_solve(terms.M.data(), nq, terms.Q.data(), x.data());
     }
     for (int i = 0; i < kDim; ++i) y[i] = yp[i] = 0;
     vmap<nq>(y) = q;

@@ -12,8 +12,8 @@
 #include <cmath>
 
 #include "methods/mechanical_method.hpp"
-#include "methods/small_linalg.hpp"
-#include "methods/weighted_pinv.hpp"
+#include "linalg/small_linalg.hpp"
+#include "linalg/weighted_pinv.hpp"
 
 namespace cstab {
 

@@ -38,8 +38,9 @@
 #include <string>
 #include <vector>
 
-#include "harness/autodiff.hpp"
-#include "harness/formulation.hpp"
+#include "core/autodiff.hpp"
+#include "core/formulation.hpp"
+#include "linalg/dense.hpp"
 #include "methods/affine.hpp"
 
 namespace cstab {
@@ -253,8 +254,7 @@ int initial_constraint_rank(const Model& model, int* rows) {
   if constexpr (MechanicalTerms<Model>::nc == 0) {
     return 0;
   } else {
-    Eigen::CompleteOrthogonalDecomposition<Eigen::Matrix<double, MechanicalTerms<Model>::nc, nq>> cod(terms.A);
-    return int(cod.rank());
+    return linalg::rank_of(terms.A);
   }
 }
 

@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-#include "harness/params.hpp"
+#include "core/params.hpp"
 #include "methods/mechanical.hpp"
 
 namespace cstab {

@@ -14,8 +14,8 @@
 #include <string>
 #include <vector>
 
-#include "harness/formulation.hpp"
-#include "harness/params.hpp"
+#include "core/formulation.hpp"
+#include "core/params.hpp"
 #include "methods/affine.hpp"
 
 namespace cstab {

@@ -10,12 +10,12 @@
 #include <string>
 #include <vector>
 
-#include "harness/format.hpp"
-#include "harness/formulation.hpp"
-#include "harness/params.hpp"
+#include "core/format.hpp"
+#include "core/formulation.hpp"
+#include "core/params.hpp"
 #include "methods/affine.hpp"
 #include "methods/mechanical.hpp"
-#include "methods/small_linalg.hpp"
+#include "linalg/small_linalg.hpp"
 
 namespace cstab {
 
@@ -60,10 +60,10 @@ class PesterevFormulation final : public AffineFormulationBase<Model> {
     Vec<double, n> X0;
     this->model_.initial_state(X0);
     jet_.evaluate(this->model_, 0.0, X0);
-    lu_.compute(jet_.A);
-    if (!(lu_.rcond() > 1e-12))
+    const double rcond = linalg::lu_rcond_of(jet_.A);
+    if (!(rcond > 1e-12))
       throw UsageError("pesterev: declared relative degrees do not hold at the initial state "
-                       "(A(X0) singular, rcond " + format_3g(lu_.rcond()) + ")");
+                       "(A(X0) singular, rcond " + format_3g(rcond) + ")");
   }
 
   bool rhs(double t, const double* y, double* dydt) override {
@@ -87,7 +87,7 @@ class PesterevFormulation final : public AffineFormulationBase<Model> {
   bool has_condition_number() const override { return true; }
   double condition_number(double t, const double* y) override {
     jet_.evaluate(this->model_, t, vmap<n>(y));
-    return condition_number_of<m>(jet_.A);
+    return linalg::condition_number_of(jet_.A);
   }
 
  private:
@@ -139,7 +139,7 @@ class PesterevMechanicalFormulation final : public MechanicalFormulationBase<Mod
   bool has_condition_number() const override { return true; }
   double condition_number(double t, const double* y) override {
     if (build(t, vmap<nq>(y).eval(), vmap<nq>(y + nq).eval(), 0.0) == Solver::Status::kMassNotPd) return NAN;
-    return condition_number_of<nc>(solver_.schur());
+    return linalg::condition_number_of(solver_.schur());
   }
 
  private:

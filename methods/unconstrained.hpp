@@ -5,7 +5,7 @@
 
 #include "methods/affine.hpp"
 #include "methods/mechanical.hpp"
-#include "methods/small_linalg.hpp"
+#include "linalg/small_linalg.hpp"
 
 namespace cstab {
 

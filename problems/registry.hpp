@@ -5,7 +5,7 @@
 #include <string>
 #include <vector>
 
-#include "harness/problem.hpp"
+#include "core/problem.hpp"
 
 namespace cstab {
 

@@ -18,7 +18,7 @@
 
 #include "harness/integrator.hpp"
 #include "harness/run.hpp"
-#include "methods/dispatch.hpp"
+#include "methods/pair.hpp"
 #include "problems/registry.hpp"
 
 namespace {

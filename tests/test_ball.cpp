@@ -20,7 +20,7 @@
 
 #include "harness/run.hpp"
 #include "methods/mechanical.hpp"
-#include "problems/ball.hpp"
+#include "problems/ball/ball.hpp"
 #include "problems/registry.hpp"
 
 namespace cstab {

@@ -28,7 +28,7 @@
 #include "methods/baumgarte.hpp"
 #include "methods/braun_goldfarb.hpp"
 #include "methods/mechanical.hpp"
-#include "problems/biped.hpp"
+#include "problems/biped/biped.hpp"
 #include "problems/registry.hpp"
 
 namespace cstab {

@@ -12,11 +12,11 @@
 #include "harness/integrator.hpp"
 #include "methods/index1.hpp"
 #include "methods/mechanical.hpp"
-#include "problems/andrews.hpp"
-#include "problems/ball.hpp"
-#include "problems/car_axis.hpp"
-#include "problems/slider_crank.hpp"
-#include "problems/wheel_sharp.hpp"
+#include "problems/andrews/andrews.hpp"
+#include "problems/ball/ball.hpp"
+#include "problems/car_axis/car_axis.hpp"
+#include "problems/slider_crank/slider_crank.hpp"
+#include "problems/wheel/wheel_sharp.hpp"
 #include "tests/expect_close.hpp"
 
 namespace cstab {
@@ -72,7 +72,7 @@ TEST(ClosedFormHolonomic, WheelMatchesAd) {
   static_assert(MechanicalTerms<WheelMechanical>::has_closed_form_nonholonomic());
   expect_closed_form_matches_ad(Wheel().mechanical());
 }
-TEST(ClosedFormHolonomic, WheelSharpMatchesAd) { expect_closed_form_matches_ad(WheelSharp().mechanical()); }
+TEST(ClosedFormHolonomic, WheelSharpMatchesAd) { expect_closed_form_matches_ad(make_wheel_sharp().mechanical()); }
 TEST(ClosedFormHolonomic, CarAxisMatchesAd) { expect_closed_form_matches_ad(CarAxis().mechanical()); }
 
 // Along whole trajectories (the wheel-sharp one passes within 3 % of the
@@ -109,7 +109,7 @@ void expect_agreement_along_trajectory(const Model& model, double t_end) {
 
 TEST(ClosedFormHolonomic, WheelAgreesAlongTrajectory) { expect_agreement_along_trajectory(Wheel().mechanical(), 5.0); }
 TEST(ClosedFormHolonomic, WheelSharpAgreesAlongTrajectory) {
-  expect_agreement_along_trajectory(WheelSharp().mechanical(), 3.0);
+  expect_agreement_along_trajectory(make_wheel_sharp().mechanical(), 3.0);
 }
 TEST(ClosedFormHolonomic, BallAgreesAlongTrajectory) { expect_agreement_along_trajectory(Ball().mechanical(), 10.0); }
 

@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "harness/run.hpp"
-#include "methods/dispatch.hpp"
+#include "methods/pair.hpp"
 #include "problems/registry.hpp"
 
 namespace cstab {

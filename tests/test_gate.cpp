@@ -16,8 +16,8 @@
 #include <string>
 #include <vector>
 
-#include "harness/gate.hpp"
-#include "harness/matrix.hpp"
+#include "gate/gate.hpp"
+#include "matrix/matrix.hpp"
 #include "tests/test_util.hpp"
 
 namespace fs = std::filesystem;

@@ -16,11 +16,11 @@
 #include <vector>
 
 #include "harness/integrator.hpp"
-#include "harness/params.hpp"
+#include "core/params.hpp"
 #include "harness/run.hpp"
 #include "methods/ida.hpp"
 #include "problems/registry.hpp"
-#include "problems/wheel.hpp"
+#include "problems/wheel/wheel.hpp"
 
 namespace cstab {
 namespace {

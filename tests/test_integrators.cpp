@@ -12,7 +12,7 @@
 #include <gsl/gsl_odeiv2.h>
 
 #include "harness/integrator.hpp"
-#include "harness/params.hpp"
+#include "core/params.hpp"
 
 namespace cstab {
 namespace {

@@ -17,9 +17,9 @@
 #include <tuple>
 
 #include "cli/matrix_commands.hpp"
-#include "harness/matrix.hpp"
+#include "matrix/matrix.hpp"
 #include "tests/test_util.hpp"
-#include "methods/dispatch.hpp"
+#include "methods/pair.hpp"
 #include "problems/registry.hpp"
 
 namespace cstab {

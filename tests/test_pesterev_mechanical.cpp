@@ -6,7 +6,7 @@
 
 #include "methods/mechanical_affine.hpp"
 #include "methods/pesterev.hpp"
-#include "problems/wheel.hpp"
+#include "problems/wheel/wheel.hpp"
 
 namespace cstab {
 namespace {

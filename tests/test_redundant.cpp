@@ -8,7 +8,7 @@
 #include <cmath>
 
 #include "harness/run.hpp"
-#include "methods/dispatch.hpp"
+#include "cstab/every_method.hpp"
 
 namespace cstab {
 namespace {
@@ -80,9 +80,9 @@ RunConfig config(const std::string& method, const std::string& integrator) {
   return cfg;
 }
 
-const ProblemAdapter<DuplicatedPendulum>& problem() {
-  static const ProblemAdapter<DuplicatedPendulum> p{DuplicatedPendulum{}};
-  return p;
+const Problem& problem() {
+  static const std::unique_ptr<Problem> p = adapt_with_every_method(DuplicatedPendulum{});
+  return *p;
 }
 
 TEST(RedundantConstraints, PseudoInverseMethodsRun) {

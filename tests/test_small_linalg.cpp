@@ -5,7 +5,7 @@
 
 #include <random>
 
-#include "methods/small_linalg.hpp"
+#include "linalg/small_linalg.hpp"
 
 namespace cstab {
 namespace {

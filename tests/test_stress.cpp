@@ -9,13 +9,13 @@
 #include <string>
 #include <vector>
 
-#include "harness/matrix.hpp"
+#include "matrix/matrix.hpp"
 #include "harness/run.hpp"
-#include "harness/stress_report.hpp"
-#include "methods/dispatch.hpp"
+#include "report/stress_report.hpp"
+#include "methods/pair.hpp"
 #include "problems/registry.hpp"
-#include "problems/wheel_sharp.hpp"
-#include "test_util.hpp"
+#include "problems/wheel/wheel_sharp.hpp"
+#include "tests/test_util.hpp"
 
 namespace cstab {
 namespace {

@@ -11,7 +11,7 @@
 #include <string>
 #include <vector>
 
-#include "harness/matrix.hpp"
+#include "matrix/matrix.hpp"
 
 namespace cstab::testing {
 

@@ -17,12 +17,12 @@
 #include <vector>
 
 #include "harness/run.hpp"
-#include "methods/dispatch.hpp"
+#include "methods/pair.hpp"
 #include "methods/mechanical.hpp"
-#include "problems/andrews.hpp"
-#include "problems/car_axis.hpp"
+#include "problems/andrews/andrews.hpp"
+#include "problems/car_axis/car_axis.hpp"
 #include "problems/registry.hpp"
-#include "problems/slider_crank.hpp"
+#include "problems/slider_crank/slider_crank.hpp"
 
 namespace cstab {
 namespace {

@@ -19,7 +19,7 @@
 #include "methods/minimal.hpp"
 #include "methods/pesterev.hpp"
 #include "problems/registry.hpp"
-#include "problems/wheel.hpp"
+#include "problems/wheel/wheel.hpp"
 #include "tests/expect_close.hpp"
 
 namespace cstab {

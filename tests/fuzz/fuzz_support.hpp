@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "harness/matrix.hpp"
+#include "matrix/matrix.hpp"
 
 namespace cstab::fuzz {
 

@@ -6,7 +6,7 @@
 #include <cstdlib>
 #include <string>
 
-#include "harness/gate.hpp"
+#include "gate/gate.hpp"
 
 namespace {
 

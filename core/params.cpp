@@ -1,0 +1,78 @@
+#include "core/params.hpp"
+
+#include <algorithm>
+#include <cstdlib>
+#include <sstream>
+
+#include "core/format.hpp"
+
+namespace cstab {
+
+double parse_finite_double(const std::string& text, const std::string& what) {
+  if (text.empty()) throw UsageError(what + ": empty value, expected a number");
+  const char* begin = text.c_str();
+  char* end = nullptr;
+  errno = 0;
+  const double value = std::strtod(begin, &end);
+  if (end != begin + text.size())
+    throw UsageError(what + ": '" + text + "' is not a number");
+  if (!std::isfinite(value))
+    throw UsageError(what + ": '" + text + "' is not a finite number");
+  return value;
+}
+
+Params Params::resolve(const std::vector<ParamSpec>& specs,
+                       const std::vector<std::pair<std::string, std::string>>& given,
+                       const std::string& method_name) {
+  Params p;
+  for (const auto& s : specs) p.values_.emplace_back(s.name, s.default_value);
+  for (const auto& given_pair : given) {
+    // Plain references: clang < 16 cannot capture structured bindings.
+    const std::string& name = given_pair.first;
+    const std::string& text = given_pair.second;
+    auto it = std::find_if(specs.begin(), specs.end(),
+                           [&](const ParamSpec& s) { return s.name == name; });
+    if (it == specs.end()) {
+      std::string known;
+      for (const auto& s : specs) known += (known.empty() ? "" : ", ") + s.name;
+      throw UsageError("--param " + name + ": unknown parameter for method '" + method_name +
+                       "' (known: " + (known.empty() ? "none" : known) + ")");
+    }
+    if (std::find(p.given_.begin(), p.given_.end(), name) != p.given_.end())
+      throw UsageError("--param " + name + ": given more than once");
+    const double value = parse_finite_double(text, "--param " + name);
+    if (it->bound == Bound::kPositive && !(value > 0))
+      throw UsageError("--param " + name + "=" + text + ": must be > 0");
+    if (it->bound == Bound::kNonNegative && !(value >= 0))
+      throw UsageError("--param " + name + "=" + text + ": must be >= 0");
+    for (auto& [n, v] : p.values_)
+      if (n == name) v = value;
+    p.given_.push_back(name);
+  }
+  return p;
+}
+
+double Params::get(const std::string& name) const {
+  for (const auto& [n, v] : values_)
+    if (n == name) return v;
+  throw std::logic_error("parameter not declared: " + name);
+}
+
+bool Params::has(const std::string& name) const {
+  return std::any_of(values_.begin(), values_.end(), [&](const auto& nv) { return nv.first == name; });
+}
+
+bool Params::given(const std::string& name) const {
+  return std::find(given_.begin(), given_.end(), name) != given_.end();
+}
+
+std::string Params::describe() const {
+  std::string out;
+  for (const auto& [n, v] : values_) {
+    if (!out.empty()) out += ';';
+    out += n + "=" + format_short(v);
+  }
+  return out;
+}
+
+}  // namespace cstab

@@ -1,0 +1,70 @@
+// A problem as the harness and the CLI see it: its description, canonical
+// coordinates, first integrals, reference solution, and a factory that turns
+// a method name into a runnable Formulation. Concrete problems are plain
+// classes in problems/; methods/problem_adapter.hpp adapts them to this interface.
+#pragma once
+
+#include <memory>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "core/formulation.hpp"
+#include "core/params.hpp"
+
+namespace cstab {
+
+struct FormulationInfo {
+  std::string name;
+  std::string description;
+  std::vector<ConstraintInfo> constraints;
+};
+
+struct ProblemInfo {
+  std::string name;
+  std::string description;
+  std::vector<std::string> coordinates;      // canonical coordinate names
+  std::vector<FormulationInfo> formulations;
+  bool has_energy = false;
+  std::vector<std::string> first_integrals;  // besides energy
+  double default_t_end = 10;
+  double reference_time = 0;                 // 0: no reference
+  std::string reference_description;
+};
+
+struct MethodInfo {
+  std::string name;
+  std::string description;
+  std::vector<ParamSpec> params;
+};
+
+class Problem {
+ public:
+  virtual ~Problem() = default;
+  virtual const ProblemInfo& info() const = 0;
+
+  // Parameters `method` takes on this problem, or throws UsageError naming
+  // why the method does not apply here.
+  virtual std::vector<ParamSpec> method_params(const std::string& method,
+                                               const std::string& formulation) const = 0;
+  virtual std::unique_ptr<Formulation> make(const std::string& method,
+                                            const std::string& formulation,
+                                            const Params& params) const = 0;
+  // Empty if `method` applies; otherwise the reason it does not.
+  virtual std::string why_not(const std::string& method) const = 0;
+
+  // The bare dynamics with every constraint ignored (M^-1 Q for a mechanical
+  // model, the drift F for an affine one): the cost baseline of benchmarks.
+  // nullptr if the problem has neither.
+  virtual std::unique_ptr<Formulation> make_unconstrained() const { return nullptr; }
+
+  // Energy of a canonical state (only if info().has_energy).
+  virtual double energy(double /*t*/, const double* /*canonical*/) const { return 0; }
+  // First integrals other than energy, in info().first_integrals order.
+  virtual void first_integrals(double /*t*/, const double* /*canonical*/, double* /*out*/) const {}
+  // Canonical state of the reference solution at time t; false if none.
+  virtual bool reference(double /*t*/, double* /*canonical*/) const { return false; }
+};
+
+
+}  // namespace cstab

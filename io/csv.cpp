@@ -1,0 +1,110 @@
+#include "io/csv.hpp"
+
+#include <unistd.h>
+
+#include <cerrno>
+#include <csignal>
+#include <cstring>
+#include <stdexcept>
+
+namespace cstab {
+
+namespace {
+
+// Temporary paths of the live AtomicFiles, readable from a signal handler:
+// fixed storage, a slot is used while its flag is set.
+constexpr int kTempSlots = 32;
+constexpr size_t kTempPathMax = 4096;
+char g_temp_paths[kTempSlots][kTempPathMax];
+volatile std::sig_atomic_t g_temp_used[kTempSlots];
+
+int claim_slot(const std::string& path) {
+  if (path.size() >= kTempPathMax) return -1;
+  for (int i = 0; i < kTempSlots; ++i) {
+    if (g_temp_used[i]) continue;
+    std::memcpy(g_temp_paths[i], path.c_str(), path.size() + 1);
+    g_temp_used[i] = 1;
+    return i;
+  }
+  return -1;  // more than kTempSlots open at once: not cleaned on a signal
+}
+
+void release_slot(int slot) {
+  if (slot >= 0) g_temp_used[slot] = 0;
+}
+
+}  // namespace
+
+void remove_temporary_files() {
+  for (int i = 0; i < kTempSlots; ++i)
+    if (g_temp_used[i]) ::unlink(g_temp_paths[i]);
+}
+
+AtomicFile::AtomicFile(std::string path) : path_(std::move(path)) {
+  temp_path_ = path_ + ".tmp." + std::to_string(::getpid());
+  slot_ = claim_slot(temp_path_);
+  file_ = std::fopen(temp_path_.c_str(), "w");
+  if (!file_) {
+    release_slot(slot_);
+    throw std::runtime_error("cannot write " + path_ + ": " + std::strerror(errno));
+  }
+}
+
+AtomicFile::~AtomicFile() {
+  if (file_) std::fclose(file_);
+  if (!committed_) std::remove(temp_path_.c_str());
+  release_slot(slot_);
+}
+
+void AtomicFile::write(const std::string& text) {
+  std::fwrite(text.data(), 1, text.size(), file_);
+}
+
+void AtomicFile::commit() {
+  const bool write_error = std::ferror(file_) != 0;
+  const bool close_error = std::fclose(file_) != 0;
+  file_ = nullptr;
+  if (write_error || close_error)
+    throw std::runtime_error("error writing " + path_);
+  if (std::rename(temp_path_.c_str(), path_.c_str()) != 0)
+    throw std::runtime_error("cannot rename into " + path_ + ": " + std::strerror(errno));
+  committed_ = true;
+  release_slot(slot_);
+  slot_ = -1;
+}
+
+std::string csv_field(const std::string& s) {
+  if (s.find_first_of(",\"\n\r") == std::string::npos) return s;
+  std::string out = "\"";
+  for (char c : s) {
+    if (c == '"') out += '"';
+    out += c;
+  }
+  return out + "\"";
+}
+
+std::string key_value_csv(const std::vector<std::pair<std::string, std::string>>& row) {
+  std::string header, values;
+  for (size_t i = 0; i < row.size(); ++i) {
+    if (i) {
+      header += ',';
+      values += ',';
+    }
+    header += csv_field(row[i].first);
+    values += csv_field(row[i].second);
+  }
+  return header + "\n" + values + "\n";
+}
+
+void write_key_value_csv(const std::string& path,
+                         const std::vector<std::pair<std::string, std::string>>& row) {
+  write_file_atomic(path, key_value_csv(row));
+}
+
+void write_file_atomic(const std::string& path, const std::string& content) {
+  AtomicFile f(path);
+  f.write(content);
+  f.commit();
+}
+
+}  // namespace cstab

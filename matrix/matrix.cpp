@@ -1,0 +1,1048 @@
+// Matrix files: parsing (a strict TOML subset) and deterministic expansion.
+#include "matrix/matrix.hpp"
+
+#include <algorithm>
+#include <cerrno>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <numeric>
+#include <set>
+#include <sstream>
+#include <stdexcept>
+
+#include "core/format.hpp"
+#include "harness/integrator.hpp"
+
+namespace cstab {
+
+std::string SourceLocation::str() const {
+  return file + ":" + std::to_string(line) + ":" + std::to_string(column);
+}
+
+std::string hash_hex(const std::string& data) {
+  std::uint64_t h = 1469598103934665603ull;
+  for (unsigned char c : data) {
+    h ^= c;
+    h *= 1099511628211ull;
+  }
+  char buf[17];
+  std::snprintf(buf, sizeof buf, "%016llx", static_cast<unsigned long long>(h));
+  return buf;
+}
+
+std::string read_text_file(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw std::runtime_error("cannot read " + path);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+// ===========================================================================
+// Parser
+
+namespace {
+
+bool is_bare_key_char(char c) {
+  return (c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '_' || c == '-';
+}
+
+class Parser {
+ public:
+  Parser(const std::string& text, const std::string& file) : s_(text), file_(file) {}
+
+  MatrixFile parse() {
+    MatrixFile out;
+    out.name = file_;
+    out.text = s_;
+    std::map<std::string, int> defaults_seen;
+    while (true) {
+      skip_blank_lines();
+      if (eof()) break;
+      if (peek() == '[') {
+        out.sections.push_back(parse_header());
+        if (out.sections.back().kind == "defaults" && ++defaults_seen["defaults"] > 1)
+          throw MatrixError(out.sections.back().where, "[defaults] given more than once");
+        continue;
+      }
+      if (out.sections.empty())
+        throw MatrixError(here(), "key outside a section: start the file with [defaults] or [[sweep]]");
+      parse_entry(out.sections.back());
+    }
+    return out;
+  }
+
+ private:
+  bool eof() const { return pos_ >= s_.size(); }
+  char peek(size_t ahead = 0) const { return pos_ + ahead < s_.size() ? s_[pos_ + ahead] : '\0'; }
+  SourceLocation here() const { return {file_, line_, col_}; }
+  void advance() {
+    if (s_[pos_] == '\n') {
+      ++line_;
+      col_ = 1;
+    } else {
+      ++col_;
+    }
+    ++pos_;
+  }
+  void skip_spaces() {
+    while (!eof() && (peek() == ' ' || peek() == '\t' || peek() == '\r')) advance();
+  }
+  void skip_comment() {
+    if (peek() == '#')
+      while (!eof() && peek() != '\n') advance();
+  }
+  // Whitespace, comments and newlines.
+  void skip_blank_lines() {
+    while (!eof()) {
+      skip_spaces();
+      skip_comment();
+      if (peek() == '\n') {
+        advance();
+        continue;
+      }
+      break;
+    }
+  }
+  // After a header or an entry: only a comment may follow on the line.
+  void expect_line_end(const char* after) {
+    skip_spaces();
+    skip_comment();
+    if (eof()) return;
+    if (peek() != '\n') throw MatrixError(here(), std::string("unexpected '") + peek() + "' after " + after);
+    advance();
+  }
+
+  MatrixSection parse_header() {
+    MatrixSection sec;
+    sec.where = here();
+    advance();  // '['
+    const bool array = peek() == '[';
+    if (array) advance();
+    skip_spaces();
+    const SourceLocation name_at = here();
+    std::string name;
+    while (!eof() && is_bare_key_char(peek())) {
+      name += peek();
+      advance();
+    }
+    skip_spaces();
+    if (peek() != ']' || (array && peek(1) != ']'))
+      throw MatrixError(here(), array ? "expected ']]' to close the [[...]] header" : "expected ']' to close the [...] header");
+    advance();
+    if (array) advance();
+    if (array && name == "sweep") {
+      sec.kind = "sweep";
+    } else if (!array && name == "defaults") {
+      sec.kind = "defaults";
+    } else if (!array && name == "sweep") {
+      throw MatrixError(name_at, "a sweep is an array of tables: write [[sweep]]");
+    } else {
+      throw MatrixError(name_at, "unknown section '" + name + "' (known: [defaults], [[sweep]])");
+    }
+    expect_line_end("the section header");
+    return sec;
+  }
+
+  void parse_entry(MatrixSection& sec) {
+    MatrixEntry e;
+    e.where = here();
+    while (true) {
+      skip_spaces();
+      const SourceLocation part_at = here();
+      std::string part;
+      while (!eof() && is_bare_key_char(peek())) {
+        part += peek();
+        advance();
+      }
+      if (part.empty()) {
+        if (eof() || peek() == '\n') throw MatrixError(part_at, "expected a key");
+        throw MatrixError(part_at, std::string("unexpected '") + peek() + "': expected a key (letters, digits, '_', '-')");
+      }
+      e.key += (e.key.empty() ? "" : ".") + part;
+      skip_spaces();
+      if (peek() == '.') {
+        advance();
+        continue;
+      }
+      break;
+    }
+    if (peek() != '=') throw MatrixError(here(), "expected '=' after key '" + e.key + "'");
+    advance();
+    skip_spaces();
+    e.value = parse_value(false);
+    for (const auto& prev : sec.entries)
+      if (prev.key == e.key)
+        throw MatrixError(e.where, "duplicate key '" + e.key + "' (first given at line " +
+                                       std::to_string(prev.where.line) + ")");
+    expect_line_end("the value");
+    sec.entries.push_back(std::move(e));
+  }
+
+  MatrixValue parse_value(bool in_array) {
+    MatrixValue v;
+    v.where = here();
+    if (eof() || peek() == '\n' || peek() == '#') throw MatrixError(here(), "expected a value");
+    const char c = peek();
+    if (c == '"' || c == '\'') {
+      v.kind = MatrixValue::Kind::kString;
+      v.text = parse_string();
+      return v;
+    }
+    if (c == '[') {
+      if (in_array) throw MatrixError(here(), "nested arrays are not supported");
+      v.kind = MatrixValue::Kind::kArray;
+      advance();
+      while (true) {
+        skip_blank_lines();
+        if (eof()) throw MatrixError(v.where, "unterminated array: missing ']'");
+        if (peek() == ']') {
+          advance();
+          break;
+        }
+        v.items.push_back(parse_value(true));
+        if (v.items.size() > 1 && v.items.back().kind != v.items.front().kind)
+          throw MatrixError(v.items.back().where, "mixed types in an array");
+        skip_blank_lines();
+        if (peek() == ',') {
+          advance();
+          continue;
+        }
+        if (peek() == ']') {
+          advance();
+          break;
+        }
+        if (eof()) throw MatrixError(v.where, "unterminated array: missing ']'");
+        throw MatrixError(here(), std::string("expected ',' or ']' in array, found '") + peek() + "'");
+      }
+      return v;
+    }
+    // A bare token: number or boolean.
+    std::string token;
+    while (!eof() && (is_bare_key_char(peek()) || peek() == '.' || peek() == '+')) {
+      token += peek();
+      advance();
+    }
+    if (token.empty()) throw MatrixError(v.where, std::string("unexpected '") + c + "': expected a value");
+    if (token == "true" || token == "false") {
+      v.kind = MatrixValue::Kind::kBool;
+      v.boolean = token == "true";
+      return v;
+    }
+    std::string digits;  // TOML allows '_' between digits
+    for (char d : token)
+      if (d != '_') digits += d;
+    char* end = nullptr;
+    errno = 0;
+    const double x = std::strtod(digits.c_str(), &end);
+    const bool numeric_start = std::isdigit(static_cast<unsigned char>(digits[0])) || digits[0] == '+' ||
+                               digits[0] == '-' || digits[0] == '.';
+    if (end == digits.c_str() + digits.size() && !std::isfinite(x))
+      throw MatrixError(v.where, "'" + token + "' is not a finite number");
+    if (!numeric_start || end != digits.c_str() + digits.size())
+      throw MatrixError(v.where, "'" + token + "' is not a number, true/false, array or string (strings are "
+                                 "quoted: \"" + token + "\")");
+    if (!std::isfinite(x) || errno == ERANGE) throw MatrixError(v.where, "'" + token + "' is not a finite number");
+    v.kind = MatrixValue::Kind::kNumber;
+    v.number = x;
+    v.text = token;
+    return v;
+  }
+
+  std::string parse_string() {
+    const SourceLocation start = here();
+    const char quote = peek();
+    advance();
+    std::string out;
+    while (true) {
+      if (eof() || peek() == '\n') throw MatrixError(start, "unterminated string");
+      const char c = peek();
+      if (c == quote) {
+        advance();
+        return out;
+      }
+      if (c == '\\' && quote == '"') {
+        const SourceLocation esc = here();
+        advance();
+        switch (eof() ? '\0' : peek()) {
+          case '"': out += '"'; break;
+          case '\\': out += '\\'; break;
+          case 'n': out += '\n'; break;
+          case 't': out += '\t'; break;
+          default: throw MatrixError(esc, "unknown escape in string (known: \\\" \\\\ \\n \\t)");
+        }
+        advance();
+        continue;
+      }
+      out += c;
+      advance();
+    }
+  }
+
+  const std::string& s_;
+  std::string file_;
+  size_t pos_ = 0;
+  int line_ = 1, col_ = 1;
+};
+
+}  // namespace
+
+MatrixFile parse_matrix(const std::string& text, const std::string& file_name) {
+  return Parser(text, file_name).parse();
+}
+
+MatrixFile read_matrix_file(const std::string& path) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) throw UsageError(path + ": is a folder, not a matrix file");
+  std::string text;
+  try {
+    text = read_text_file(path);
+  } catch (const std::exception&) {
+    throw UsageError(path + ": cannot read the matrix file");
+  }
+  return parse_matrix(text, path);
+}
+
+// ===========================================================================
+// Expansion
+
+namespace {
+
+using Kind = MatrixValue::Kind;
+
+const std::vector<std::string>& known_keys() {
+  static const std::vector<std::string> keys = {
+      "name", "problems", "methods", "formulations", "integrators", "step", "tol", "rtol", "atol",
+      "t_end", "ref_time", "times", "sample_every", "blowup", "observe_every", "series", "repeats",
+      "timeout", "repeat_if_under", "work_precision", "overlay", "optional", "perturb"};
+  return keys;
+}
+
+size_t edit_distance(const std::string& a, const std::string& b) {
+  std::vector<size_t> prev(b.size() + 1), cur(b.size() + 1);
+  std::iota(prev.begin(), prev.end(), 0);
+  for (size_t i = 1; i <= a.size(); ++i) {
+    cur[0] = i;
+    for (size_t j = 1; j <= b.size(); ++j)
+      cur[j] = std::min({prev[j] + 1, cur[j - 1] + 1, prev[j - 1] + (a[i - 1] != b[j - 1])});
+    std::swap(prev, cur);
+  }
+  return prev[b.size()];
+}
+
+std::string suggestion(const std::string& word, const std::vector<std::string>& known) {
+  std::string best;
+  size_t best_d = 3;
+  for (const auto& k : known) {
+    const size_t d = edit_distance(word, k);
+    // "problem" -> "problems" and the like
+    if (d < best_d || (k.rfind(word, 0) == 0 && d <= 2)) {
+      best = k;
+      best_d = d;
+    }
+  }
+  return best.empty() ? "" : " (did you mean '" + best + "'?)";
+}
+
+std::string join(const std::vector<std::string>& v, const std::string& sep) {
+  std::string out;
+  for (const auto& s : v) out += (out.empty() ? "" : sep) + s;
+  return out;
+}
+
+const char* kind_name(Kind k) {
+  switch (k) {
+    case Kind::kString: return "a string";
+    case Kind::kNumber: return "a number";
+    case Kind::kBool: return "true/false";
+    default: return "an array";
+  }
+}
+
+// A sweep's settings: its own entries over [defaults].
+class Settings {
+ public:
+  Settings(const MatrixSection* defaults, const MatrixSection& sweep) : sweep_(sweep) {
+    if (defaults)
+      for (const auto& e : defaults->entries) values_[e.key] = &e;
+    for (const auto& e : sweep.entries) values_[e.key] = &e;
+  }
+
+  const MatrixEntry* find(const std::string& key) const {
+    auto it = values_.find(key);
+    return it == values_.end() ? nullptr : it->second;
+  }
+  const SourceLocation& where() const { return sweep_.where; }
+
+  // Every element (a scalar is a one-element list), all of kind `k`.
+  std::vector<const MatrixValue*> list(const std::string& key, Kind k) const {
+    std::vector<const MatrixValue*> out;
+    const MatrixEntry* e = find(key);
+    if (!e) return out;
+    if (e->value.kind == Kind::kArray) {
+      if (e->value.items.empty()) throw MatrixError(e->value.where, key + ": empty array");
+      for (const auto& item : e->value.items) out.push_back(&item);
+    } else {
+      out.push_back(&e->value);
+    }
+    for (const auto* v : out)
+      if (v->kind != k)
+        throw MatrixError(v->where, key + ": expected " + std::string(kind_name(k)) + ", found " + kind_name(v->kind));
+    return out;
+  }
+  const MatrixValue* scalar(const std::string& key, Kind k) const {
+    const MatrixEntry* e = find(key);
+    if (!e) return nullptr;
+    if (e->value.kind != k)
+      throw MatrixError(e->value.where, key + ": expected " + std::string(kind_name(k)) + ", found " +
+                                            kind_name(e->value.kind));
+    return &e->value;
+  }
+  double number(const std::string& key, double fallback) const {
+    const MatrixValue* v = scalar(key, Kind::kNumber);
+    return v ? v->number : fallback;
+  }
+  bool boolean(const std::string& key, bool fallback) const {
+    const MatrixValue* v = scalar(key, Kind::kBool);
+    return v ? v->boolean : fallback;
+  }
+  // "all" or a list of names.
+  std::vector<const MatrixValue*> names(const std::string& key, bool* all) const {
+    *all = false;
+    const MatrixEntry* e = find(key);
+    if (e && e->value.kind == Kind::kString && e->value.text == "all") {
+      *all = true;
+      return {};
+    }
+    return list(key, Kind::kString);
+  }
+
+  std::vector<const MatrixEntry*> params() const {
+    std::vector<const MatrixEntry*> out;
+    for (const auto& [key, e] : values_)
+      if (key.rfind("param.", 0) == 0) out.push_back(e);
+    // file order: defaults first, then the sweep's own
+    std::sort(out.begin(), out.end(), [](const MatrixEntry* a, const MatrixEntry* b) {
+      return std::make_pair(a->where.line, a->where.column) < std::make_pair(b->where.line, b->where.column);
+    });
+    return out;
+  }
+
+ private:
+  const MatrixSection& sweep_;
+  std::map<std::string, const MatrixEntry*> values_;
+};
+
+void check_keys(const MatrixSection& sec) {
+  for (const auto& e : sec.entries) {
+    if (e.key.rfind("param.", 0) == 0) {
+      const size_t dots = std::count(e.key.begin(), e.key.end(), '.');
+      if (dots > 2) throw MatrixError(e.where, "'" + e.key + "': write param.NAME or param.METHOD.NAME");
+      continue;
+    }
+    if (sec.kind == "defaults" && e.key == "name")
+      throw MatrixError(e.where, "'name' belongs in a [[sweep]], not in [defaults]");
+    const auto& known = known_keys();
+    if (std::find(known.begin(), known.end(), e.key) == known.end())
+      throw MatrixError(e.where, "unknown key '" + e.key + "'" + suggestion(e.key, known) +
+                                     "; known: " + join(known, ", ") + ", param.NAME, param.METHOD.NAME");
+  }
+}
+
+struct TEnd {
+  std::string mode;  // "", "ref", "default"
+  double value = 0;
+  SourceLocation where;
+};
+
+struct ParamChoice {
+  std::string method;  // empty: any method declaring `name`
+  std::string name;
+  std::vector<const MatrixValue*> values;
+  SourceLocation where;
+  bool used = false;
+};
+
+double estimate_cost(const RunConfig& c, const IntegratorInfo& integ, int repeats) {
+  double evals;
+  if (integ.fixed_step) {
+    evals = c.t_end / c.step.step * (integ.name == "rk4" ? 4 : 2);
+  } else {
+    const double tol = std::min(c.step.rtol, c.step.atol);
+    evals = c.t_end * 50 * std::pow(tol, -1.0 / std::max(integ.order, 1)) * 10;
+  }
+  return evals * repeats;
+}
+
+std::string canonical_text(const RunConfig& c, int repeats, double timeout, double repeat_if_under) {
+  std::string params;
+  for (const auto& [k, v] : c.params) params += (params.empty() ? "" : ";") + k + "=" + v;
+  std::string times;
+  for (double t : c.times) times += (times.empty() ? "" : ",") + format_exact(t);
+  std::ostringstream s;
+  s << "problem=" << c.problem << "\nmethod=" << c.method << "\nformulation=" << c.formulation
+    << "\nintegrator=" << c.integrator << "\nstep=" << format_exact(c.step.step)
+    << "\nrtol=" << format_exact(c.step.rtol) << "\natol=" << format_exact(c.step.atol) << "\nparams=" << params
+    << "\nt_end=" << format_exact(c.t_end) << "\ntimes=" << times << "\nsample_every=" << format_exact(c.sample_every)
+    << "\nref_time=" << format_exact(c.ref_time) << "\nblowup=" << format_exact(c.blowup)
+    << "\nobserve_every=" << c.observe_every << "\nseries=" << (c.write_series ? 1 : 0) << "\nrepeats=" << repeats
+    << "\ntimeout=" << format_exact(timeout);
+  if (repeat_if_under > 0) s << "\nrepeat_if_under=" << format_exact(repeat_if_under);
+  // Only when set, so that the ids of unperturbed cases stay what they were.
+  if (c.perturb > 0) s << "\nperturb=" << format_exact(c.perturb);
+  s << "\n";
+  return s.str();
+}
+
+}  // namespace
+
+std::string CaseEntry::label() const {
+  std::string s = problem + " " + method + (formulation.empty() ? "" : "[" + formulation + "]") + " " + integrator +
+                  " " + setting + " t_end=" + format_short(t_end);
+  if (!params.empty()) s += " " + params;
+  if (repeats > 1) s += " x" + std::to_string(repeats);
+  return s;
+}
+
+// Limits on one matrix (the default one has under 1000 cases).
+constexpr size_t kMaxCases = 100000;
+
+Expansion expand_matrix(const MatrixFile& file, const MatrixCatalog& catalog) {
+  Expansion out;
+  const MatrixSection* defaults = nullptr;
+  for (const auto& sec : file.sections) {
+    check_keys(sec);
+    if (sec.kind == "defaults") defaults = &sec;
+  }
+  std::set<std::string> seen_ids, seen_names;
+  size_t duplicates = 0;
+  double planned = 0;  // upper bound of the cases so far
+  int sweep_number = 0;
+  for (const auto& sec : file.sections) {
+    if (sec.kind != "sweep") continue;
+    ++sweep_number;
+    const Settings set(defaults, sec);
+    const bool optional = set.boolean("optional", false);
+
+    std::string name = "sweep" + std::to_string(sweep_number);
+    if (const MatrixValue* v = set.scalar("name", Kind::kString)) {
+      if (v->text.empty() || v->text.find_first_of(",\"\n") != std::string::npos)
+        throw MatrixError(v->where, "name: must be non-empty, without commas or quotes");
+      name = v->text;
+      if (!seen_names.insert(name).second) throw MatrixError(v->where, "name: '" + name + "' used by another sweep");
+    }
+    auto note = [&](const std::string& text) { out.notes.push_back("sweep '" + name + "': " + text); };
+    const size_t notes_before = out.notes.size();
+
+    // ---- problems ----
+    bool every_problem = false;
+    std::vector<const Problem*> problems;
+    const auto problem_names = set.names("problems", &every_problem);
+    if (every_problem) {
+      problems = catalog.problems;
+    } else {
+      if (problem_names.empty()) throw MatrixError(sec.where, "sweep '" + name + "' has no 'problems'");
+      for (const auto* v : problem_names) {
+        auto it = std::find_if(catalog.problems.begin(), catalog.problems.end(),
+                               [&](const Problem* p) { return p->info().name == v->text; });
+        if (it != catalog.problems.end()) {
+          problems.push_back(*it);
+          continue;
+        }
+        std::vector<std::string> known;
+        for (const auto* p : catalog.problems) known.push_back(p->info().name);
+        if (optional) {
+          note("problem '" + v->text + "' is not in this build (optional sweep): skipped");
+          continue;
+        }
+        throw MatrixError(v->where, "unknown problem '" + v->text + "'" + suggestion(v->text, known) +
+                                        " (known: " + join(known, ", ") + "; or \"all\")");
+      }
+    }
+
+    // ---- methods ----
+    bool every_method = false;
+    std::vector<const MethodInfo*> methods;
+    const auto method_names = set.names("methods", &every_method);
+    if (every_method) {
+      for (const auto& m : catalog.methods) methods.push_back(&m);
+    } else {
+      if (method_names.empty()) throw MatrixError(sec.where, "sweep '" + name + "' has no 'methods'");
+      for (const auto* v : method_names) {
+        auto it = std::find_if(catalog.methods.begin(), catalog.methods.end(),
+                               [&](const MethodInfo& m) { return m.name == v->text; });
+        if (it != catalog.methods.end()) {
+          methods.push_back(&*it);
+          continue;
+        }
+        std::vector<std::string> known;
+        for (const auto& m : catalog.methods) known.push_back(m.name);
+        if (optional) {
+          note("method '" + v->text + "' is not in this build (optional sweep): skipped");
+          continue;
+        }
+        throw MatrixError(v->where, "unknown method '" + v->text + "'" + suggestion(v->text, known) +
+                                        " (known: " + join(known, ", ") + "; or \"all\")");
+      }
+    }
+
+    // ---- integrators and their step settings ----
+    bool every_integrator = false;
+    std::vector<const IntegratorInfo*> integrators;
+    const auto integrator_names = set.names("integrators", &every_integrator);
+    if (every_integrator) {
+      for (const auto& i : all_integrators()) integrators.push_back(&i);
+    } else {
+      if (integrator_names.empty()) throw MatrixError(sec.where, "sweep '" + name + "' has no 'integrators'");
+      for (const auto* v : integrator_names) {
+        auto it = std::find_if(all_integrators().begin(), all_integrators().end(),
+                               [&](const IntegratorInfo& i) { return i.name == v->text; });
+        if (it == all_integrators().end() && optional) {
+          note("integrator '" + v->text + "' is not in this build (optional sweep): skipped");
+          continue;
+        }
+        if (it == all_integrators().end()) {
+          std::vector<std::string> known;
+          for (const auto& i : all_integrators()) known.push_back(i.name);
+          throw MatrixError(v->where, "unknown integrator '" + v->text + "'" + suggestion(v->text, known) +
+                                          " (known: " + join(known, ", ") + ")");
+        }
+        integrators.push_back(&*it);
+      }
+    }
+    const auto steps = set.list("step", Kind::kNumber);
+    const auto tols = set.list("tol", Kind::kNumber);
+    const auto rtols = set.list("rtol", Kind::kNumber);
+    const auto atols = set.list("atol", Kind::kNumber);
+    for (const auto* list : {&steps, &tols, &rtols, &atols})
+      for (const auto* v : *list)
+        if (!(v->number > 0)) throw MatrixError(v->where, "step sizes and tolerances must be > 0");
+    if (!tols.empty() && (!rtols.empty() || !atols.empty()))
+      throw MatrixError(set.find("tol")->where, "give either 'tol' (rtol = atol) or 'rtol' and 'atol', not both");
+    if (tols.empty() && (rtols.empty() != atols.empty()))
+      throw MatrixError((rtols.empty() ? set.find("atol") : set.find("rtol"))->where,
+                        "'rtol' and 'atol' go together (or use 'tol' for both)");
+    const bool have_tol = !tols.empty() || !rtols.empty();
+    bool any_fixed = false, any_adaptive = false;
+    for (const auto* i : integrators) {
+      (i->fixed_step ? any_fixed : any_adaptive) = true;
+      const MatrixEntry* ie = set.find("integrators");
+      const SourceLocation& at = ie ? ie->where : sec.where;
+      if (i->fixed_step && steps.empty())
+        throw MatrixError(at, "integrator '" + i->name + "' is fixed-step: the sweep needs 'step'");
+      if (!i->fixed_step && !have_tol)
+        throw MatrixError(at, "integrator '" + i->name + "' is adaptive: the sweep needs 'tol' (or 'rtol' and 'atol')");
+    }
+    if (!steps.empty() && !any_fixed && !integrators.empty())
+      throw MatrixError(set.find("step")->where, "'step' given but no integrator of the sweep is fixed-step");
+    if (have_tol && !any_adaptive && !integrators.empty())
+      throw MatrixError((tols.empty() ? set.find("rtol") : set.find("tol"))->where,
+                        "tolerances given but no integrator of the sweep is adaptive");
+
+    // ---- horizon, observation, repeats ----
+    std::vector<TEnd> t_ends;
+    if (const MatrixEntry* e = set.find("t_end")) {
+      std::vector<const MatrixValue*> vals;
+      if (e->value.kind == Kind::kArray)
+        for (const auto& item : e->value.items) vals.push_back(&item);
+      else
+        vals.push_back(&e->value);
+      for (const auto* v : vals) {
+        if (v->kind == Kind::kString && (v->text == "ref" || v->text == "default")) {
+          t_ends.push_back({v->text, 0, v->where});
+        } else if (v->kind == Kind::kNumber && v->number > 0) {
+          t_ends.push_back({"", v->number, v->where});
+        } else {
+          throw MatrixError(v->where, "t_end: expected a number > 0, \"ref\" (the problem's reference time) or "
+                                      "\"default\" (the problem's default horizon)");
+        }
+      }
+    } else {
+      t_ends.push_back({"default", 0, sec.where});
+    }
+    std::vector<const MatrixValue*> formulations = set.list("formulations", Kind::kString);
+    const auto times = set.list("times", Kind::kNumber);
+    const double ref_time = set.number("ref_time", -1);
+    const double sample_every = set.number("sample_every", 0);
+    const double blowup = set.number("blowup", 1e3);
+    const double observe_every = set.number("observe_every", 1);
+    const double repeats_num = set.number("repeats", 1);
+    const double timeout = set.number("timeout", 0);
+    const double repeat_if_under = set.number("repeat_if_under", 0);
+    auto check = [&](const char* key, bool ok, const std::string& what) {
+      if (!ok) throw MatrixError(set.find(key)->value.where, std::string(key) + ": " + what);
+    };
+    if (set.find("ref_time")) check("ref_time", ref_time >= 0, "must be >= 0 (0: no reference error)");
+    if (set.find("sample_every")) check("sample_every", sample_every >= 0, "must be >= 0 (0: t_end / 1000)");
+    if (set.find("blowup")) check("blowup", blowup > 0, "must be > 0");
+    if (set.find("observe_every"))
+      check("observe_every", observe_every >= 1 && observe_every <= 1e9 && observe_every == std::floor(observe_every),
+            "must be an integer in [1, 1e9]");
+    for (const auto* v : times)
+      if (!(v->number > 0)) throw MatrixError(v->where, "times: " + v->text + " must be > 0");
+    if (set.find("repeats"))
+      check("repeats", repeats_num >= 1 && repeats_num <= 1000 && repeats_num == std::floor(repeats_num),
+            "must be an integer in [1, 1000]");
+    if (set.find("timeout")) check("timeout", timeout >= 0, "must be >= 0 seconds (0: none)");
+    if (set.find("repeat_if_under"))
+      check("repeat_if_under", repeat_if_under >= 0, "must be >= 0 seconds (0: always repeat)");
+    const int repeats = int(repeats_num);
+    const bool series = set.boolean("series", true);
+    std::vector<double> perturbs;
+    for (const auto* v : set.list("perturb", Kind::kNumber)) {
+      if (!std::isfinite(v->number) || v->number < 0)
+        throw MatrixError(v->where, "perturb: must be a number >= 0 (0: consistent start)");
+      perturbs.push_back(v->number);
+    }
+    if (perturbs.empty()) perturbs.push_back(0);
+    const bool work_precision = set.boolean("work_precision", true);
+    const bool overlay = set.boolean("overlay", false);
+
+    // ---- parameters ----
+    std::vector<ParamChoice> param_choices;
+    for (const MatrixEntry* e : set.params()) {
+      ParamChoice pc;
+      const std::string rest = e->key.substr(6);
+      const size_t dot = rest.find('.');
+      if (dot == std::string::npos) {
+        pc.name = rest;
+      } else {
+        pc.method = rest.substr(0, dot);
+        pc.name = rest.substr(dot + 1);
+        if (std::none_of(catalog.methods.begin(), catalog.methods.end(),
+                         [&](const MethodInfo& m) { return m.name == pc.method; }) && !optional)
+          throw MatrixError(e->where, "'" + e->key + "': unknown method '" + pc.method + "'");
+      }
+      pc.where = e->where;
+      if (e->value.kind == Kind::kArray) {
+        if (e->value.items.empty()) throw MatrixError(e->value.where, e->key + ": empty array");
+        for (const auto& item : e->value.items) pc.values.push_back(&item);
+      } else {
+        pc.values.push_back(&e->value);
+      }
+      for (const auto* v : pc.values)
+        if (v->kind != Kind::kNumber) throw MatrixError(v->where, e->key + ": expected a number");
+      param_choices.push_back(std::move(pc));
+    }
+
+    for (const auto* f : formulations) {
+      const bool known = std::any_of(problems.begin(), problems.end(), [&](const Problem* p) {
+        const auto& fs = p->info().formulations;
+        return std::any_of(fs.begin(), fs.end(), [&](const FormulationInfo& fi) { return fi.name == f->text; });
+      });
+      if (!known && !problems.empty()) {
+        std::vector<std::string> names;
+        for (const Problem* p : problems)
+          for (const auto& fi : p->info().formulations)
+            if (std::find(names.begin(), names.end(), fi.name) == names.end()) names.push_back(fi.name);
+        throw MatrixError(f->where, "unknown formulation '" + f->text + "'" + suggestion(f->text, names) +
+                                        " for the sweep's problems (known: " + join(names, ", ") + ")");
+      }
+    }
+
+    // ---- the product ----
+    size_t not_applicable = 0, wrong_integrator = 0;
+    const size_t cases_before = out.cases.size(), duplicates_before = duplicates;
+    for (const Problem* problem : problems) {
+      const ProblemInfo& info = problem->info();
+      for (const MethodInfo* method : methods) {
+        const std::string why = problem->why_not(method->name);
+        if (!why.empty()) {
+          if (!every_method && !every_problem)
+            note(method->name + " does not apply to " + info.name + ": " + why);
+          ++not_applicable;
+          continue;
+        }
+        // Parameters this method declares on this problem, and which of the
+        // sweep's param.* keys apply to it.
+        std::vector<ParamSpec> specs;
+        try {
+          specs = problem->method_params(method->name, "");
+        } catch (const UsageError& e) {
+          note(method->name + " on " + info.name + ": " + e.what());
+          continue;
+        }
+        // A DAE formulation F(t, y, y') = 0 needs a DAE integrator and an
+        // ODE one an ODE integrator: impossible pairs are not cases.
+        int is_dae = -1;  // -1: unknown (the formulation cannot be built with defaults)
+        try {
+          const auto f = problem->make(method->name, "", Params::resolve(specs, {}, method->name));
+          if (f) is_dae = dynamic_cast<const DaeSystem*>(f.get()) != nullptr;
+        } catch (const UsageError&) {
+        }
+        std::vector<ParamChoice*> applying;
+        for (auto& pc : param_choices) {
+          if (!pc.method.empty() && pc.method != method->name) continue;
+          if (std::none_of(specs.begin(), specs.end(), [&](const ParamSpec& s) { return s.name == pc.name; })) {
+            if (!pc.method.empty()) {
+              std::vector<std::string> known;
+              for (const auto& s : specs) known.push_back(s.name);
+              throw MatrixError(pc.where, "method '" + method->name + "' has no parameter '" + pc.name +
+                                              "' on problem '" + info.name + "' (known: " + join(known, ", ") + ")");
+            }
+            continue;
+          }
+          const ParamSpec& spec =
+              *std::find_if(specs.begin(), specs.end(), [&](const ParamSpec& s) { return s.name == pc.name; });
+          for (const auto* v : pc.values) {
+            if (spec.bound == Bound::kPositive && !(v->number > 0))
+              throw MatrixError(v->where, "param." + pc.name + " = " + v->text + ": must be > 0 for method '" +
+                                              method->name + "'");
+            if (spec.bound == Bound::kNonNegative && !(v->number >= 0))
+              throw MatrixError(v->where, "param." + pc.name + " = " + v->text + ": must be >= 0 for method '" +
+                                              method->name + "'");
+          }
+          pc.used = true;
+          applying.push_back(&pc);
+        }
+        std::vector<std::string> forms;
+        for (const auto* f : formulations) forms.push_back(f->text);
+        if (forms.empty()) forms.push_back("");
+        // An upper bound of what this pair adds, checked before anything is
+        // built: a typo like four arrays of 100 values must not eat the machine.
+        double planned_here = double(forms.size()) * double(integrators.size()) * double(t_ends.size()) *
+                              double(std::max({steps.size(), tols.size(), rtols.size() * atols.size(), size_t(1)}));
+        planned_here *= double(perturbs.size());
+        for (const ParamChoice* pc : applying) planned_here *= double(pc->values.size());
+        planned += planned_here;
+        if (planned > double(kMaxCases))
+          throw MatrixError(sec.where, "the matrix expands to more than " + std::to_string(kMaxCases) +
+                                           " cases: split it into several files");
+        for (const std::string& form : forms) {
+          if (!form.empty()) {
+            try {
+              problem->method_params(method->name, form);
+            } catch (const UsageError&) {
+              note(method->name + " on " + info.name + " has no formulation '" + form + "': skipped");
+              continue;
+            }
+          }
+          for (const IntegratorInfo* integ : integrators) {
+            if (is_dae >= 0 && bool(is_dae) != integ->solves_dae) {
+              ++wrong_integrator;
+              continue;
+            }
+            for (const TEnd& te : t_ends) {
+              double t_end = te.value;
+              if (te.mode == "ref") t_end = info.reference_time > 0 ? info.reference_time : info.default_t_end;
+              if (te.mode == "default") t_end = info.default_t_end;
+              if (ref_time > t_end)
+                throw MatrixError(set.find("ref_time")->value.where,
+                                  "ref_time: " + set.find("ref_time")->value.text + " is beyond t_end " +
+                                      format_short(t_end) + " (problem '" + info.name + "')");
+              for (const auto* v : times)
+                if (v->number > t_end)
+                  throw MatrixError(v->where, "times: " + v->text + " is beyond t_end " + format_short(t_end) +
+                                                  " (problem '" + info.name + "')");
+              // step settings
+              std::vector<StepSettings> settings;
+              if (integ->fixed_step) {
+                for (const auto* v : steps) {
+                  if (v->number > t_end) {
+                    note(info.name + ": step " + v->text + " larger than t_end " + format_short(t_end) + ": skipped");
+                    continue;
+                  }
+                  settings.push_back({v->number, 0, 0});
+                }
+              } else if (!tols.empty()) {
+                for (const auto* v : tols) settings.push_back({0, v->number, v->number});
+              } else {
+                for (const auto* r : rtols)
+                  for (const auto* a : atols) settings.push_back({0, r->number, a->number});
+              }
+              // parameter combinations (odometer over the applying choices)
+              std::vector<size_t> pick(applying.size(), 0);
+              while (true) {
+                for (const StepSettings& st : settings) for (const double perturb : perturbs) {
+                  MatrixCase c;
+                  RunConfig& cfg = c.config;
+                  cfg.problem = info.name;
+                  cfg.method = method->name;
+                  cfg.formulation = form;
+                  cfg.integrator = integ->name;
+                  for (size_t i = 0; i < applying.size(); ++i)
+                    cfg.params.emplace_back(applying[i]->name,
+                                            format_short(applying[i]->values[pick[i]]->number));
+                  cfg.step = st;
+                  cfg.t_end = t_end;
+                  for (const auto* v : times) cfg.times.push_back(v->number);
+                  cfg.sample_every = sample_every;
+                  cfg.ref_time = ref_time;
+                  cfg.blowup = blowup;
+                  cfg.observe_every = int(observe_every);
+                  cfg.write_series = series;
+                  cfg.perturb = perturb;
+                  c.timeout = timeout;
+                  c.repeat_if_under = repeat_if_under;
+                  c.config_text = canonical_text(cfg, repeats, timeout, repeat_if_under);
+                  CaseEntry& e = c.entry;
+                  e.id = hash_hex(c.config_text);
+                  if (!seen_ids.insert(e.id).second) {
+                    ++duplicates;
+                    continue;
+                  }
+                  e.index = out.cases.size();
+                  e.sweep = name;
+                  e.problem = cfg.problem;
+                  e.method = cfg.method;
+                  e.formulation = form;
+                  e.integrator = cfg.integrator;
+                  for (const auto& [k, v] : cfg.params) e.params += (e.params.empty() ? "" : ";") + k + "=" + v;
+                  if (integ->fixed_step)
+                    e.setting = "step=" + format_short(st.step);
+                  else if (st.rtol == st.atol)
+                    e.setting = "tol=" + format_short(st.rtol);
+                  else
+                    e.setting = "rtol=" + format_short(st.rtol) + ";atol=" + format_short(st.atol);
+                  if (perturb > 0) e.setting += ";perturb=" + format_short(perturb);
+                  e.t_end = t_end;
+                  e.repeats = repeats;
+                  e.work_precision = work_precision;
+                  e.overlay = overlay;
+                  e.curve = e.method + (form.empty() ? "" : "[" + form + "]") + "/" + e.integrator +
+                            (e.params.empty() ? "" : " " + e.params);
+                  c.cost_estimate = estimate_cost(cfg, *integ, repeats);
+                  out.cases.push_back(std::move(c));
+                }
+                size_t i = 0;
+                while (i < pick.size() && ++pick[i] == applying[i]->values.size()) pick[i++] = 0;
+                if (i == pick.size()) break;
+              }
+            }
+          }
+        }
+      }
+    }
+    for (const auto& pc : param_choices)
+      if (!pc.used && !optional)
+        note("param." + (pc.method.empty() ? "" : pc.method + ".") + pc.name + " (line " +
+             std::to_string(pc.where.line) + ") applies to no method of the sweep");
+    if (wrong_integrator)
+      note(std::to_string(wrong_integrator) + " method x integrator combinations skipped: DAE methods (ida-*) need "
+           "integrator 'ida', and 'ida' needs a DAE method");
+    if (out.cases.size() == cases_before && duplicates == duplicates_before && !optional) {
+      std::string why;
+      for (size_t i = notes_before; i < out.notes.size(); ++i) why += "; " + out.notes[i];
+      throw MatrixError(sec.where, "sweep '" + name + "' expands to no case" +
+                                       (why.empty() ? std::string() : why));
+    }
+    if (not_applicable && (every_method || every_problem))
+      note(std::to_string(not_applicable) + " problem x method combinations do not apply (see `cstab list`)");
+  }
+  if (duplicates) out.notes.push_back(std::to_string(duplicates) + " duplicate cases dropped (same configuration)");
+  if (sweep_number == 0) throw MatrixError({file.name, 1, 1}, "no [[sweep]] table: nothing to run");
+  return out;
+}
+
+std::pair<int, int> parse_shard(const std::string& text) {
+  const size_t slash = text.find('/');
+  auto parse_int = [&](const std::string& s) {
+    char* end = nullptr;
+    const long v = std::strtol(s.c_str(), &end, 10);
+    if (s.empty() || *end != '\0') throw UsageError("--shard " + text + ": expected k/N, e.g. 2/4");
+    return v;
+  };
+  if (slash == std::string::npos) throw UsageError("--shard " + text + ": expected k/N, e.g. 2/4");
+  const long k = parse_int(text.substr(0, slash)), n = parse_int(text.substr(slash + 1));
+  if (n < 1 || n > 100000 || k < 1 || k > n) throw UsageError("--shard " + text + ": need 1 <= k <= N");
+  return {int(k), int(n)};
+}
+
+std::vector<MatrixCase> select_cases(const std::vector<MatrixCase>& cases, const std::string& filter,
+                                     int shard_k, int shard_n) {
+  std::vector<const MatrixCase*> kept;
+  for (const auto& c : cases)
+    if (filter.empty() || c.entry.label().find(filter) != std::string::npos || c.entry.id == filter ||
+        c.entry.sweep == filter)
+      kept.push_back(&c);
+  if (shard_n > 1) {
+    std::vector<const MatrixCase*> by_cost = kept;
+    std::stable_sort(by_cost.begin(), by_cost.end(), [](const MatrixCase* a, const MatrixCase* b) {
+      return a->cost_estimate > b->cost_estimate;
+    });
+    std::set<size_t> mine;
+    for (size_t i = 0; i < by_cost.size(); ++i)
+      if (int(i % shard_n) == shard_k - 1) mine.insert(by_cost[i]->entry.index);
+    kept.erase(std::remove_if(kept.begin(), kept.end(), [&](const MatrixCase* c) { return !mine.count(c->entry.index); }),
+               kept.end());
+  }
+  std::vector<MatrixCase> out;
+  for (const auto* c : kept) out.push_back(*c);
+  return out;
+}
+
+// ===========================================================================
+// CSV reader
+
+int CsvTable::column(const std::string& name) const {
+  for (size_t i = 0; i < header.size(); ++i)
+    if (header[i] == name) return int(i);
+  return -1;
+}
+
+const std::string& CsvTable::get(size_t row, const std::string& name) const {
+  static const std::string empty;
+  const int c = column(name);
+  if (c < 0 || row >= rows.size() || size_t(c) >= rows[row].size()) return empty;
+  return rows[row][c];
+}
+
+CsvTable read_csv(const std::string& path) {
+  const std::string text = read_text_file(path);
+  std::vector<std::vector<std::string>> records;
+  std::vector<std::string> record;
+  std::string field;
+  bool quoted = false, field_started = false;
+  for (size_t i = 0; i < text.size(); ++i) {
+    const char c = text[i];
+    if (quoted) {
+      if (c == '"') {
+        if (i + 1 < text.size() && text[i + 1] == '"') {
+          field += '"';
+          ++i;
+        } else {
+          quoted = false;
+        }
+      } else {
+        field += c;
+      }
+      continue;
+    }
+    if (c == '"' && field.empty()) {
+      quoted = true;
+      field_started = true;
+    } else if (c == ',') {
+      record.push_back(std::move(field));
+      field.clear();
+      field_started = true;
+    } else if (c == '\n') {
+      if (field_started || !field.empty() || !record.empty()) {
+        record.push_back(std::move(field));
+        records.push_back(std::move(record));
+      }
+      field.clear();
+      record.clear();
+      field_started = false;
+    } else if (c != '\r') {
+      field += c;
+      field_started = true;
+    }
+  }
+  if (field_started || !field.empty() || !record.empty()) {
+    record.push_back(std::move(field));
+    records.push_back(std::move(record));
+  }
+  if (quoted) throw std::runtime_error(path + ": unterminated quoted field");
+  CsvTable t;
+  if (records.empty()) return t;
+  t.header = std::move(records.front());
+  t.rows.assign(std::make_move_iterator(records.begin() + 1), std::make_move_iterator(records.end()));
+  return t;
+}
+
+}  // namespace cstab

@@ -1,0 +1,212 @@
+// The benchmark matrix: a declarative file of sweeps, expanded into cases,
+// each run (in a forked worker process) into DIR/cases/<case_id>/.
+//
+// File format (docs/matrix.md has the full reference): a strict subset of
+// TOML. Comments start with '#'. One optional [defaults] table, then any
+// number of [[sweep]] tables; every key of a sweep may be a single value or
+// an array, and a sweep is the Cartesian product of its arrays:
+//
+//     [defaults]
+//     repeats = 3
+//
+//     [[sweep]]
+//     name = "wp-rk4"
+//     problems = "all"                  # or ["wheel", "ball"]
+//     methods = "all"                   # applicable methods only
+//     integrators = ["rk4", "adams"]
+//     step = [1e-2, 1e-3, 1e-4]         # fixed-step integrators
+//     t_end = "ref"                     # number | "ref" | "default"
+//     param.lambda = [100, 1500]        # only for methods declaring it
+//
+// Expansion is deterministic (file order, then the order of every array,
+// problems/methods in registry order for "all"). A case's id is a hash of
+// its run configuration alone, so the same case keeps its folder and its id
+// across rebuilds and matrices (thresholds and comparisons can name it); the
+// cache key stored beside the result adds the binary's identity, so a case
+// is rerun exactly when its configuration or the cstab binary changed.
+#pragma once
+
+#include <functional>
+#include <iosfwd>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "core/problem.hpp"
+#include "harness/run.hpp"
+
+namespace cstab {
+
+// ---------------------------------------------------------------------------
+// Parsing
+
+struct SourceLocation {
+  std::string file;
+  int line = 0, column = 0;  // 1-based
+  std::string str() const;   // "file:line:column"
+};
+
+// A malformed or inconsistent matrix file; what() is "file:line:col: message".
+struct MatrixError : UsageError {
+  MatrixError(const SourceLocation& where, const std::string& message)
+      : UsageError(where.str() + ": " + message) {}
+};
+
+struct MatrixValue {
+  enum class Kind { kString, kNumber, kBool, kArray };
+  Kind kind = Kind::kString;
+  std::string text;  // string contents, or the number's source text
+  double number = 0;
+  bool boolean = false;
+  std::vector<MatrixValue> items;  // kArray (never nested)
+  SourceLocation where;
+};
+
+struct MatrixEntry {
+  std::string key;  // dotted keys joined with '.', e.g. "param.lambda"
+  SourceLocation where;
+  MatrixValue value;
+};
+
+struct MatrixSection {
+  std::string kind;  // "defaults" or "sweep"
+  SourceLocation where;
+  std::vector<MatrixEntry> entries;
+};
+
+struct MatrixFile {
+  std::string name;  // file name used in messages
+  std::string text;  // verbatim source (stored in every results folder)
+  std::vector<MatrixSection> sections;
+};
+
+MatrixFile parse_matrix(const std::string& text, const std::string& file_name);
+MatrixFile read_matrix_file(const std::string& path);  // throws UsageError if unreadable
+
+// ---------------------------------------------------------------------------
+// Expansion
+
+// What one results folder needs to know about a case without re-expanding
+// the matrix (written to DIR/cases.csv; merge and report work from it).
+struct CaseEntry {
+  size_t index = 0;         // position in the full expansion (before filter/shard)
+  std::string id;           // 16 hex digits
+  std::string sweep;        // name of the [[sweep]] it came from
+  std::string problem, method, formulation, integrator;
+  std::string params;       // given parameters, "a=1;b=2" (defaults not listed)
+  std::string setting;      // "step=0.001" or "tol=1e-08" or "rtol=..;atol=.."
+  double t_end = 0;
+  int repeats = 1;
+  bool work_precision = true;  // a point of the problem's work-precision diagram
+  bool overlay = false;        // candidate for the per-method time-series overlays
+  std::string curve;           // work-precision curve: method/integrator[ params]
+  std::string label() const;   // one line for progress output
+};
+
+struct MatrixCase {
+  CaseEntry entry;
+  RunConfig config;
+  double timeout = 0;        // seconds, 0: none
+  double repeat_if_under = 0;  // repeat only while a run takes less (seconds); 0: always
+  std::string config_text;   // canonical configuration; id = hash(config_text)
+  double cost_estimate = 0;  // relative, for scheduling and shard balance
+};
+
+struct MatrixCatalog {
+  std::vector<const Problem*> problems;  // registry order
+  std::vector<MethodInfo> methods;       // registry order
+};
+
+struct Expansion {
+  std::vector<MatrixCase> cases;
+  std::vector<std::string> notes;  // skipped combinations, duplicates, ...
+};
+
+// Throws MatrixError (with file:line:col) for any inconsistency.
+Expansion expand_matrix(const MatrixFile& file, const MatrixCatalog& catalog);
+
+// Cases whose label contains `filter` (empty: all), then shard k of n
+// (1-based): cases ordered by estimated cost, dealt round-robin, so shards
+// are disjoint, cover everything, and carry similar work. Result in
+// expansion order.
+std::vector<MatrixCase> select_cases(const std::vector<MatrixCase>& cases, const std::string& filter,
+                                     int shard_k, int shard_n);
+// "k/N" -> (k, N); throws UsageError.
+std::pair<int, int> parse_shard(const std::string& text);
+
+// 64-bit FNV-1a as 16 hex digits.
+std::string hash_hex(const std::string& data);
+
+// ---------------------------------------------------------------------------
+// Running
+
+struct MatrixRunOptions {
+  std::string out_dir;
+  int jobs = 1;
+  bool force = false;          // rerun even if cached
+  std::string binary_id;       // part of every cache key
+  std::string matrix_text;     // stored as DIR/matrix.toml
+  size_t selected_cases = 0;   // cases after --filter, before --shard (merge checks coverage)
+  std::function<const Problem&(const std::string&)> find_problem;
+};
+
+struct MatrixRunStats {
+  size_t total = 0, run = 0, cached = 0, failed = 0, diverged = 0;
+  size_t not_applicable = 0;  // rejected by the harness before running (status "invalid")
+  size_t unfinished = 0;      // not run or killed unfinished (interrupted): rerun next time
+  int interrupted_by = 0;     // SIGINT, SIGTERM or SIGHUP that stopped the matrix; 0: ran to the end
+  double seconds = 0;
+};
+
+// Runs every case not already complete in out_dir, `jobs` at a time, each in
+// a forked process (a crash or a hang is a recorded result, never the end of
+// the matrix). Writes DIR/cases.csv and DIR/matrix.toml first, then
+// DIR/cases/<id>/{summary.csv, series.csv, key.txt}; key.txt last, so a
+// folder without it is incomplete. Progress goes to `log`: one updating line
+// on a terminal, plain lines otherwise.
+//
+// SIGINT, SIGTERM or SIGHUP (while it runs) stop the matrix cleanly: no new
+// case starts, running workers get SIGTERM (SIGKILL after a grace period),
+// a worker that still finished keeps its result, the folders of killed ones
+// are removed, and run_matrix returns with `interrupted_by` set. A worker
+// killed by one of these signals from outside is an unfinished case, never a
+// `crashed` result. Rerunning resumes: finished cases are cached.
+MatrixRunStats run_matrix(const std::vector<MatrixCase>& cases, const MatrixRunOptions& options,
+                          std::ostream& log, bool log_is_tty);
+// "SIGINT", "SIGTERM", "SIGHUP" (for messages about `interrupted_by`).
+std::string stop_signal_name(int sig);
+
+// The manifest DIR/cases.csv.
+// `selected_cases`: how many cases the run was given before sharding.
+void write_manifest(const std::string& path, const std::vector<CaseEntry>& entries, size_t selected_cases);
+std::vector<CaseEntry> read_manifest(const std::string& path, size_t* selected_cases = nullptr);
+// DIR/cases.csv of a results folder in expansion order; UsageError naming
+// DIR if it is not a matrix results folder.
+std::vector<CaseEntry> read_results_manifest(const std::string& dir);
+
+// DIR/summary.csv: every case's summary rows (one per repeat) in expansion
+// order, columns case_id, repeat, sweep, then the union of all cases'
+// columns in order of first appearance. Cases without a complete result are
+// left out and counted in the return value.
+size_t write_matrix_summary(const std::string& dir, const std::vector<CaseEntry>& entries);
+
+// Joins shard folders into out_dir: checks they ran the same matrix, copies
+// the case folders, writes the union manifest, provenance of every shard
+// and summary.csv. Returns the number of cases missing (not in any shard, or
+// without a complete result).
+size_t merge_results(const std::string& out_dir, const std::vector<std::string>& shard_dirs,
+                     std::ostream& log);
+
+// ---------------------------------------------------------------------------
+// Small CSV reader (RFC 4180 quoting) for the files this suite writes.
+
+struct CsvTable {
+  std::vector<std::string> header;
+  std::vector<std::vector<std::string>> rows;
+  int column(const std::string& name) const;  // -1 if absent
+  const std::string& get(size_t row, const std::string& name) const;  // "" if absent
+};
+CsvTable read_csv(const std::string& path);  // throws std::runtime_error
+std::string read_text_file(const std::string& path);  // throws std::runtime_error
+
+}  // namespace cstab

@@ -1,0 +1,642 @@
+// Running a matrix: a pool of forked workers, the per-case cache, progress,
+// the manifest and summary of a results folder, and merging shard folders.
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <chrono>
+#include <cmath>
+#include <csignal>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <iostream>
+#include <map>
+#include <set>
+#include <sstream>
+#include <thread>
+
+#include "io/csv.hpp"
+#include "core/format.hpp"
+#include "matrix/matrix.hpp"
+#include "matrix/provenance.hpp"
+
+namespace cstab {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+using Row = std::vector<std::pair<std::string, std::string>>;
+using Clock = std::chrono::steady_clock;
+
+// Child exit codes.
+constexpr int kExitOk = 0, kExitDiverged = 10, kExitFailed = 11, kExitInvalid = 12;
+
+std::string case_folder(const std::string& out, const std::string& id) { return out + "/cases/" + id; }
+
+std::string cache_key(const MatrixCase& c, const std::string& binary_id) {
+  return c.config_text + "binary=" + binary_id + "\n";
+}
+
+bool file_equals(const std::string& path, const std::string& content) {
+  std::FILE* f = std::fopen(path.c_str(), "rb");
+  if (!f) return false;
+  std::string data(content.size() + 1, '\0');
+  const size_t n = std::fread(data.data(), 1, data.size(), f);
+  std::fclose(f);
+  return n == content.size() && data.compare(0, n, content) == 0;
+}
+
+// Rows with possibly different columns -> one CSV (union of columns).
+std::string rows_to_csv(const std::vector<Row>& rows) {
+  std::vector<std::string> columns;
+  std::map<std::string, size_t> position;
+  for (const auto& row : rows)
+    for (const auto& [k, v] : row)
+      if (position.emplace(k, columns.size()).second) columns.push_back(k);
+  std::string out;
+  for (size_t i = 0; i < columns.size(); ++i) out += (i ? "," : "") + csv_field(columns[i]);
+  out += "\n";
+  std::vector<const std::string*> cells(columns.size());
+  for (const auto& row : rows) {
+    std::fill(cells.begin(), cells.end(), nullptr);
+    for (const auto& [k, v] : row) cells[position[k]] = &v;
+    for (size_t i = 0; i < cells.size(); ++i) {
+      if (i) out += ',';
+      if (cells[i]) out += csv_field(*cells[i]);
+    }
+    out += "\n";
+  }
+  return out;
+}
+
+// A row for a case that produced no RunResult (crash, timeout, bad input).
+Row failure_row(const MatrixCase& c, const std::string& status, const std::string& reason) {
+  const RunConfig& cfg = c.config;
+  Row row;
+  row.emplace_back("case_id", c.entry.id);
+  row.emplace_back("repeat", "0");
+  row.emplace_back("problem", cfg.problem);
+  row.emplace_back("formulation", cfg.formulation);
+  row.emplace_back("method", cfg.method);
+  row.emplace_back("params", c.entry.params);
+  row.emplace_back("integrator", cfg.integrator);
+  row.emplace_back("step", cfg.step.step > 0 ? format_short(cfg.step.step) : "");
+  row.emplace_back("rtol", cfg.step.rtol > 0 ? format_short(cfg.step.rtol) : "");
+  row.emplace_back("atol", cfg.step.atol > 0 ? format_short(cfg.step.atol) : "");
+  row.emplace_back("status", status);
+  row.emplace_back("reason", reason);
+  row.emplace_back("t_end", format_short(cfg.t_end));
+  return row;
+}
+
+void write_result(const std::string& dir, const std::vector<Row>& rows, const std::string& key) {
+  write_file_atomic(dir + "/summary.csv", rows_to_csv(rows));
+  write_file_atomic(dir + "/key.txt", key);  // last: marks the result complete
+}
+
+// In the forked worker: every repeat of one case. Returns the exit code.
+int run_in_worker(const MatrixCase& c, const Problem& problem, const std::string& dir, const std::string& key) {
+  std::vector<Row> rows;
+  int code = kExitOk;
+  for (int r = 0; r < c.entry.repeats; ++r) {
+    RunConfig cfg = c.config;
+    cfg.write_series = cfg.write_series && r == 0;
+    RunResult result;
+    try {
+      result = run_case(problem, cfg, r == 0 ? dir : std::string());
+    } catch (const UsageError& e) {
+      rows = {failure_row(c, "invalid", e.what())};
+      code = kExitInvalid;
+      break;
+    } catch (const std::exception& e) {
+      rows = {failure_row(c, "failed", std::string("exception: ") + e.what())};
+      code = kExitFailed;
+      break;
+    }
+    Row row = result.summary_row();
+    row.insert(row.begin(), {{"case_id", c.entry.id}, {"repeat", std::to_string(r)}});
+    rows.push_back(std::move(row));
+    if (result.status != "ok") {  // repeats only time successful runs
+      code = result.status == "diverged" ? kExitDiverged : kExitFailed;
+      break;
+    }
+    // A long run is timed well enough once.
+    if (c.repeat_if_under > 0 && result.wall_seconds >= c.repeat_if_under) break;
+  }
+  write_result(dir, rows, key);
+  return code;
+}
+
+std::string clock_text(double seconds) {
+  if (!std::isfinite(seconds) || seconds < 0) return "?";
+  const long s = long(seconds + 0.5);
+  char buf[32];
+  if (s >= 3600)
+    std::snprintf(buf, sizeof buf, "%ld:%02ld:%02ld", s / 3600, (s / 60) % 60, s % 60);
+  else
+    std::snprintf(buf, sizeof buf, "%ld:%02ld", s / 60, s % 60);
+  return buf;
+}
+
+struct Running {
+  const MatrixCase* c;
+  Clock::time_point start;
+};
+
+// ---- interruption ----
+// The signal that asked the matrix to stop (0: none). Set by the handler only.
+volatile std::sig_atomic_t g_stop_signal = 0;
+extern "C" void on_stop_signal(int sig) {
+  if (!g_stop_signal) g_stop_signal = sig;
+}
+constexpr int kStopSignals[] = {SIGINT, SIGTERM, SIGHUP};
+
+// A worker killed by one of these was interrupted, not crashed.
+bool is_stop_signal(int sig) { return sig == SIGINT || sig == SIGTERM || sig == SIGHUP; }
+
+// While alive, SIGINT/SIGTERM/SIGHUP set g_stop_signal instead of killing
+// the process; the previous dispositions come back afterwards. A signal
+// ignored on entry (a background job of a non-interactive shell, nohup)
+// stays ignored, here and in the workers.
+bool g_ignored[std::size(kStopSignals)];
+
+class StopSignals {
+ public:
+  StopSignals() {
+    g_stop_signal = 0;
+    struct sigaction sa {};
+    sa.sa_handler = on_stop_signal;
+    sigemptyset(&sa.sa_mask);
+    for (size_t i = 0; i < std::size(kStopSignals); ++i) {
+      ::sigaction(kStopSignals[i], nullptr, &old_[i]);
+      g_ignored[i] = old_[i].sa_handler == SIG_IGN;
+      if (!g_ignored[i]) ::sigaction(kStopSignals[i], &sa, nullptr);
+    }
+  }
+  ~StopSignals() {
+    for (size_t i = 0; i < std::size(kStopSignals); ++i) ::sigaction(kStopSignals[i], &old_[i], nullptr);
+  }
+  StopSignals(const StopSignals&) = delete;
+  StopSignals& operator=(const StopSignals&) = delete;
+
+  // Blocks the stop signals (around fork(), so a child never runs the
+  // parent's handler), and unblocks them.
+  static void block(bool on) {
+    sigset_t set;
+    sigemptyset(&set);
+    for (int sig : kStopSignals) sigaddset(&set, sig);
+    ::sigprocmask(on ? SIG_BLOCK : SIG_UNBLOCK, &set, nullptr);
+  }
+  // In a worker: the default actions, so a stop signal ends it at once.
+  static void defaults_in_child() {
+    for (size_t i = 0; i < std::size(kStopSignals); ++i) ::signal(kStopSignals[i], g_ignored[i] ? SIG_IGN : SIG_DFL);
+    block(false);
+  }
+
+ private:
+  struct sigaction old_[std::size(kStopSignals)];
+};
+
+const char* signal_name(int sig) {
+  switch (sig) {
+    case SIGINT: return "SIGINT";
+    case SIGTERM: return "SIGTERM";
+    case SIGHUP: return "SIGHUP";
+    default: return "a signal";
+  }
+}
+
+}  // namespace
+
+std::string stop_signal_name(int sig) { return signal_name(sig); }
+
+MatrixRunStats run_matrix(const std::vector<MatrixCase>& cases, const MatrixRunOptions& opt, std::ostream& log,
+                          bool tty) {
+  const auto start = Clock::now();
+  auto elapsed = [&] { return std::chrono::duration<double>(Clock::now() - start).count(); };
+  MatrixRunStats stats;
+  stats.total = cases.size();
+  const StopSignals stop_signals;
+
+  std::error_code ec;
+  fs::create_directories(opt.out_dir + "/cases", ec);
+  if (ec) throw UsageError("--out " + opt.out_dir + ": cannot create folder: " + ec.message());
+  {
+    std::vector<CaseEntry> entries;
+    for (const auto& c : cases) entries.push_back(c.entry);
+    write_manifest(opt.out_dir + "/cases.csv", entries, opt.selected_cases);
+    write_file_atomic(opt.out_dir + "/matrix.toml", opt.matrix_text);
+  }
+
+  // ---- what is cached ----
+  std::vector<const MatrixCase*> todo;
+  for (const auto& c : cases) {
+    const std::string dir = case_folder(opt.out_dir, c.entry.id);
+    if (!opt.force && file_equals(dir + "/key.txt", cache_key(c, opt.binary_id))) {
+      ++stats.cached;
+      continue;
+    }
+    todo.push_back(&c);
+  }
+  if (stats.cached)
+    log << "matrix: " << stats.cached << " of " << stats.total
+        << " cases cached (same configuration and binary, result in " << opt.out_dir << "/cases): not rerun\n";
+  if (todo.empty()) {
+    stats.seconds = elapsed();
+    return stats;
+  }
+  // Longest first, so the pool does not end waiting on one long case.
+  std::stable_sort(todo.begin(), todo.end(),
+                   [](const MatrixCase* a, const MatrixCase* b) { return a->cost_estimate > b->cost_estimate; });
+
+  // ---- reference solutions: computed once here, inherited by every worker ----
+  {
+    std::set<std::pair<std::string, double>> done;
+    for (const MatrixCase* c : todo) {
+      if (g_stop_signal) break;
+      const Problem& p = opt.find_problem(c->config.problem);
+      const double t = c->config.ref_time < 0 ? p.info().reference_time : c->config.ref_time;
+      if (!(t > 0) || t > c->config.t_end || !done.insert({c->config.problem, t}).second) continue;
+      std::vector<double> buf(p.info().coordinates.size());
+      p.reference(t, buf.data());
+    }
+  }
+
+  double cost_total = 0, cost_done = 0;
+  for (const MatrixCase* c : todo) cost_total += c->cost_estimate;
+  const size_t jobs = size_t(std::max(1, opt.jobs));
+  std::map<pid_t, Running> running;
+  size_t next = 0, finished = 0;
+  auto last_draw = Clock::now() - std::chrono::seconds(1);
+
+  auto progress_line = [&] {
+    const double t = elapsed();
+    const double eta = cost_done > 0 ? t * (cost_total - cost_done) / cost_done : NAN;
+    std::ostringstream s;
+    s << "[" << (stats.cached + finished) << "/" << stats.total << "] " << clock_text(t) << " elapsed, ETA "
+      << (finished == todo.size() ? "0:00" : clock_text(eta)) << ", " << stats.failed << " failed, "
+      << stats.diverged << " diverged, " << stats.not_applicable << " n/a, " << stats.cached << " cached, "
+      << running.size() << " running";
+    return s.str();
+  };
+  auto draw = [&](bool force) {
+    if (!tty) return;
+    if (!force && Clock::now() - last_draw < std::chrono::milliseconds(200)) return;
+    last_draw = Clock::now();
+    log << "\r\033[K" << progress_line() << std::flush;
+  };
+
+  // A worker that did not finish (stopped by a signal): no result, its
+  // partial folder removed, run again next time.
+  auto unfinished = [&](const MatrixCase& c, const std::string& why) {
+    fs::remove_all(case_folder(opt.out_dir, c.entry.id), ec);
+    ++stats.unfinished;
+    ++finished;
+    if (tty) log << "\r\033[K";
+    log << "[" << (stats.cached + finished) << "/" << stats.total << "] unfinished " << c.entry.label() << "  ("
+        << c.entry.id << ")\n    " << why << ": not recorded, runs again next time\n" << std::flush;
+  };
+
+  auto record = [&](const MatrixCase& c, int wait_status, double seconds, bool timed_out) {
+    const std::string dir = case_folder(opt.out_dir, c.entry.id);
+    std::string outcome, reason;
+    if (!timed_out && WIFSIGNALED(wait_status) && is_stop_signal(WTERMSIG(wait_status))) {
+      unfinished(c, std::string("worker stopped by ") + signal_name(WTERMSIG(wait_status)));
+      return;
+    }
+    if (timed_out) {
+      outcome = "timeout";
+      reason = "killed after " + format_short(c.timeout) + " s (timeout)";
+    } else if (WIFEXITED(wait_status)) {
+      switch (WEXITSTATUS(wait_status)) {
+        case kExitOk: outcome = "ok"; break;
+        case kExitDiverged: outcome = "diverged"; break;
+        case kExitFailed: outcome = "failed"; break;
+        case kExitInvalid: outcome = "invalid"; break;
+        default:
+          outcome = "crashed";
+          reason = "worker exited with code " + std::to_string(WEXITSTATUS(wait_status));
+      }
+    } else if (WIFSIGNALED(wait_status)) {
+      outcome = "crashed";
+      reason = std::string("worker killed by signal ") + std::to_string(WTERMSIG(wait_status)) + " (" +
+               strsignal(WTERMSIG(wait_status)) + ")";
+    }
+    if (outcome == "crashed" || outcome == "timeout") {
+      try {
+        write_result(dir, {failure_row(c, outcome, reason)}, cache_key(c, opt.binary_id));
+      } catch (const std::exception& e) {
+        reason += "; cannot record: " + std::string(e.what());
+      }
+    }
+    const bool failure = outcome != "ok" && outcome != "diverged" && outcome != "invalid";
+    if (outcome == "diverged") ++stats.diverged;
+    if (outcome == "invalid") ++stats.not_applicable;
+    if (failure) ++stats.failed;
+    if (outcome != "ok" && outcome != "diverged") {
+      if (reason.empty()) {
+        try {
+          reason = read_csv(dir + "/summary.csv").get(0, "reason");
+        } catch (const std::exception&) {
+        }
+      }
+    }
+    ++stats.run;
+    ++finished;
+    cost_done += c.cost_estimate;
+    std::ostringstream line;
+    char head[96];
+    const double t = elapsed();
+    const std::string eta = finished == todo.size() ? "0:00" : clock_text(t * (cost_total - cost_done) / cost_done);
+    std::snprintf(head, sizeof head, "[%zu/%zu %s, ETA %s] %-8s %7.2fs  ", stats.cached + finished, stats.total,
+                  clock_text(t).c_str(), eta.c_str(), outcome == "invalid" ? "n/a" : outcome.c_str(), seconds);
+    line << head << c.entry.label() << "  (" << c.entry.id << ")";
+    if (!reason.empty() && outcome != "ok" && outcome != "diverged") line << "\n    " << reason;
+    if (tty) {
+      if (failure) log << "\r\033[K" << line.str() << "\n";
+      draw(true);
+    } else {
+      log << line.str() << "\n" << std::flush;
+    }
+  };
+
+  while (!g_stop_signal && (next < todo.size() || !running.empty())) {
+    while (!g_stop_signal && running.size() < jobs && next < todo.size()) {
+      const MatrixCase& c = *todo[next++];
+      const std::string dir = case_folder(opt.out_dir, c.entry.id);
+      fs::remove_all(dir, ec);  // nothing stale survives: incomplete until the worker writes key.txt
+      fs::create_directories(dir, ec);
+      const std::string key = cache_key(c, opt.binary_id);
+      const Problem& problem = opt.find_problem(c.config.problem);
+      log.flush();
+      std::fflush(nullptr);
+      StopSignals::block(true);
+      const pid_t pid = ::fork();
+      if (pid == 0) {
+        StopSignals::defaults_in_child();
+        int code = kExitFailed;
+        try {
+          code = run_in_worker(c, problem, dir, key);
+        } catch (...) {
+          code = 99;
+        }
+        std::fflush(nullptr);
+        ::_exit(code);
+      }
+      StopSignals::block(false);
+      if (pid < 0) throw std::runtime_error(std::string("fork failed: ") + std::strerror(errno));
+      running[pid] = {&c, Clock::now()};
+      draw(false);
+    }
+    int status = 0;
+    const pid_t pid = ::waitpid(-1, &status, WNOHANG);
+    if (pid > 0) {
+      auto it = running.find(pid);
+      if (it == running.end()) continue;  // not ours
+      const Running r = it->second;
+      running.erase(it);
+      record(*r.c, status, std::chrono::duration<double>(Clock::now() - r.start).count(), false);
+      continue;
+    }
+    // Timeouts.
+    for (auto it = running.begin(); it != running.end();) {
+      const double age = std::chrono::duration<double>(Clock::now() - it->second.start).count();
+      if (it->second.c->timeout > 0 && age > it->second.c->timeout) {
+        ::kill(it->first, SIGKILL);
+        ::waitpid(it->first, &status, 0);
+        const Running r = it->second;
+        it = running.erase(it);
+        record(*r.c, status, age, true);
+      } else {
+        ++it;
+      }
+    }
+    draw(false);
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  if (g_stop_signal) {
+    // Stop: nothing new starts; running workers get SIGTERM, SIGKILL after
+    // a grace period. One that still exits on its own has finished (its
+    // key.txt is written) and is recorded; the others leave no folder.
+    stats.interrupted_by = g_stop_signal;
+    if (tty) log << "\r\033[K";
+    log << "matrix: " << signal_name(stats.interrupted_by) << " received: stopping " << running.size()
+        << " running cases; " << (todo.size() - next) << " not started\n" << std::flush;
+    for (const auto& [pid, r] : running) ::kill(pid, SIGTERM);
+    const auto deadline = Clock::now() + std::chrono::seconds(3);
+    while (!running.empty()) {
+      int status = 0;
+      const pid_t pid = ::waitpid(-1, &status, WNOHANG);
+      if (pid > 0) {
+        auto it = running.find(pid);
+        if (it == running.end()) continue;
+        const Running r = it->second;
+        running.erase(it);
+        record(*r.c, status, std::chrono::duration<double>(Clock::now() - r.start).count(), false);
+        continue;
+      }
+      if (Clock::now() > deadline) {
+        for (auto it = running.begin(); it != running.end(); it = running.erase(it)) {
+          ::kill(it->first, SIGKILL);
+          ::waitpid(it->first, &status, 0);
+          unfinished(*it->second.c, "worker did not stop within 3 s of SIGTERM: killed");
+        }
+        break;
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    }
+    stats.unfinished += todo.size() - next;
+  }
+  stats.seconds = elapsed();
+  if (tty) log << "\r\033[K" << progress_line() << "\n";
+  return stats;
+}
+
+// ---------------------------------------------------------------------------
+
+void write_manifest(const std::string& path, const std::vector<CaseEntry>& entries, size_t selected_cases) {
+  std::vector<Row> rows;
+  for (const auto& e : entries) {
+    rows.push_back({{"index", std::to_string(e.index)},
+                    {"case_id", e.id},
+                    {"sweep", e.sweep},
+                    {"problem", e.problem},
+                    {"method", e.method},
+                    {"formulation", e.formulation},
+                    {"integrator", e.integrator},
+                    {"params", e.params},
+                    {"setting", e.setting},
+                    {"t_end", format_exact(e.t_end)},
+                    {"repeats", std::to_string(e.repeats)},
+                    {"work_precision", e.work_precision ? "1" : "0"},
+                    {"overlay", e.overlay ? "1" : "0"},
+                    {"curve", e.curve},
+                    {"selected_cases", std::to_string(selected_cases)}});
+  }
+  if (rows.empty())
+    write_file_atomic(path,
+                      "index,case_id,sweep,problem,method,formulation,integrator,params,setting,t_end,repeats,"
+                      "work_precision,overlay,curve,selected_cases\n");
+  else
+    write_file_atomic(path, rows_to_csv(rows));
+}
+
+std::vector<CaseEntry> read_results_manifest(const std::string& dir) {
+  std::vector<CaseEntry> entries;
+  try {
+    entries = read_manifest(dir + "/cases.csv");
+  } catch (const std::runtime_error& e) {
+    throw UsageError(dir + ": not a matrix results folder (" + e.what() + ")");
+  }
+  std::sort(entries.begin(), entries.end(), [](const CaseEntry& a, const CaseEntry& b) { return a.index < b.index; });
+  return entries;
+}
+
+std::vector<CaseEntry> read_manifest(const std::string& path, size_t* selected_cases) {
+  const CsvTable t = read_csv(path);
+  for (const char* col : {"index", "case_id", "problem", "method", "integrator", "curve"})
+    if (t.column(col) < 0) throw UsageError(path + ": not a cstab case manifest (no column '" + col + "')");
+  std::vector<CaseEntry> out;
+  if (selected_cases) *selected_cases = 0;
+  for (size_t i = 0; i < t.rows.size(); ++i) {
+    CaseEntry e;
+    e.index = std::stoul(t.get(i, "index"));
+    e.id = t.get(i, "case_id");
+    e.sweep = t.get(i, "sweep");
+    e.problem = t.get(i, "problem");
+    e.method = t.get(i, "method");
+    e.formulation = t.get(i, "formulation");
+    e.integrator = t.get(i, "integrator");
+    e.params = t.get(i, "params");
+    e.setting = t.get(i, "setting");
+    e.t_end = std::stod(t.get(i, "t_end"));
+    e.repeats = std::stoi(t.get(i, "repeats"));
+    e.work_precision = t.get(i, "work_precision") == "1";
+    e.overlay = t.get(i, "overlay") == "1";
+    e.curve = t.get(i, "curve");
+    if (selected_cases && !t.get(i, "selected_cases").empty()) *selected_cases = std::stoul(t.get(i, "selected_cases"));
+    out.push_back(std::move(e));
+  }
+  return out;
+}
+
+size_t write_matrix_summary(const std::string& dir, const std::vector<CaseEntry>& entries) {
+  std::vector<Row> rows;
+  size_t missing = 0;
+  for (const auto& e : entries) {
+    const std::string folder = case_folder(dir, e.id);
+    if (!fs::exists(folder + "/key.txt")) {
+      ++missing;
+      continue;
+    }
+    CsvTable t;
+    try {
+      t = read_csv(folder + "/summary.csv");
+    } catch (const std::exception&) {
+      ++missing;
+      continue;
+    }
+    for (const auto& cells : t.rows) {
+      Row row;
+      for (size_t i = 0; i < t.header.size(); ++i) {
+        row.emplace_back(t.header[i], i < cells.size() ? cells[i] : "");
+        if (t.header[i] == "repeat") row.emplace_back("sweep", e.sweep);
+      }
+      rows.push_back(std::move(row));
+    }
+  }
+  if (rows.empty())
+    write_file_atomic(dir + "/summary.csv", "case_id,repeat,sweep\n");
+  else
+    write_file_atomic(dir + "/summary.csv", rows_to_csv(rows));
+  return missing;
+}
+
+size_t merge_results(const std::string& out_dir, const std::vector<std::string>& shard_dirs, std::ostream& log) {
+  if (shard_dirs.empty()) throw UsageError("give at least one shard folder");
+  std::string matrix_text;
+  std::map<size_t, std::pair<CaseEntry, std::string>> by_index;  // index -> entry, source folder
+  size_t selected_cases = 0;
+  std::set<std::string> binaries;
+  Provenance merged;
+  for (size_t s = 0; s < shard_dirs.size(); ++s) {
+    const std::string& dir = shard_dirs[s];
+    std::error_code same_ec;
+    if (fs::equivalent(dir, out_dir, same_ec))
+      throw UsageError("the output folder " + out_dir + " is also a shard folder");
+    std::string text;
+    try {
+      text = read_text_file(dir + "/matrix.toml");
+    } catch (const std::exception&) {
+      throw UsageError(dir + " is not a matrix results folder (no matrix.toml)");
+    }
+    if (s == 0)
+      matrix_text = text;
+    else if (text != matrix_text)
+      throw UsageError(dir + " ran a different matrix than " + shard_dirs[0] +
+                       " (matrix.toml differs)");
+    size_t n = 0;
+    std::vector<CaseEntry> entries;
+    try {
+      entries = read_manifest(dir + "/cases.csv", &n);
+    } catch (const std::runtime_error& e) {
+      throw UsageError(dir + ": " + e.what());
+    }
+    if (n) selected_cases = n;
+    for (auto& e : entries) {
+      auto [it, inserted] = by_index.emplace(e.index, std::make_pair(e, dir));
+      if (!inserted && it->second.first.id != e.id)
+        throw UsageError("case " + std::to_string(e.index) + " differs between " + it->second.second +
+                         " and " + dir);
+    }
+    try {
+      for (auto [k, v] : parse_provenance(read_text_file(dir + "/provenance.txt"))) {
+        if (k == "binary_identity") binaries.insert(v);
+        merged.emplace_back("shard" + std::to_string(s + 1) + "." + k, v);
+      }
+    } catch (const std::exception&) {
+    }
+  }
+  if (binaries.size() > 1)
+    log << "merge: warning: the shards were run by " << binaries.size() << " different binaries\n";
+
+  std::error_code ec;
+  fs::create_directories(out_dir + "/cases", ec);
+  if (ec) throw UsageError("cannot create " + out_dir + ": " + ec.message());
+  std::vector<CaseEntry> entries;
+  size_t copied = 0;
+  for (const auto& [index, entry_source] : by_index) {
+    const auto& [e, source] = entry_source;
+    entries.push_back(e);
+    const std::string from = case_folder(source, e.id), to = case_folder(out_dir, e.id);
+    if (!fs::exists(from + "/key.txt")) continue;  // counted by write_matrix_summary
+    const std::string key = read_text_file(from + "/key.txt");
+    if (file_equals(to + "/key.txt", key)) continue;
+    fs::create_directories(to, ec);
+    fs::remove(to + "/key.txt", ec);
+    for (const auto& f : fs::directory_iterator(from)) {
+      if (f.path().filename() == "key.txt" || !f.is_regular_file()) continue;
+      fs::copy_file(f.path(), to + "/" + f.path().filename().string(), fs::copy_options::overwrite_existing);
+    }
+    write_file_atomic(to + "/key.txt", key);
+    ++copied;
+  }
+  write_file_atomic(out_dir + "/matrix.toml", matrix_text);
+  write_manifest(out_dir + "/cases.csv", entries, selected_cases);
+  Provenance own = collect_provenance();
+  own.emplace_back("merged_from", std::to_string(shard_dirs.size()) + " shard folders");
+  own.insert(own.end(), merged.begin(), merged.end());
+  write_file_atomic(out_dir + "/provenance.txt", format_provenance(own));
+  const size_t missing_results = write_matrix_summary(out_dir, entries);
+  const size_t uncovered = selected_cases > entries.size() ? selected_cases - entries.size() : 0;
+  log << "merge: " << entries.size() << " cases from " << shard_dirs.size() << " folders (" << copied
+      << " copied) into " << out_dir << "\n";
+  if (missing_results) log << "merge: warning: " << missing_results << " cases have no complete result\n";
+  return uncovered + missing_results;
+}
+
+}  // namespace cstab

@@ -1,0 +1,93 @@
+// Adapts a concrete problem class (problems/<name>/) to the runtime Problem
+// interface. Its methods come as a table of PairOps, one per entry of
+// all_methods(), each compiled in its own translation unit; a method that
+// does not apply says why (why_not), nothing is silently skipped.
+#pragma once
+
+#include <memory>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "core/problem.hpp"
+#include "methods/pair.hpp"
+#include "methods/unconstrained.hpp"
+
+namespace cstab {
+
+template <class P>
+class ProblemAdapter final : public Problem {
+ public:
+  ProblemAdapter(P problem, std::vector<PairOps> pairs)
+      : p_(std::move(problem)), info_(p_.info()), pairs_(std::move(pairs)) {}
+
+  const ProblemInfo& info() const override { return info_; }
+
+  std::string why_not(const std::string& method) const override {
+    return pair(method).why_not(&p_);
+  }
+
+  std::vector<ParamSpec> method_params(const std::string& method,
+                                       const std::string& formulation) const override {
+    check_applies(method);
+    return pair(method).params(&p_, formulation);
+  }
+
+  std::unique_ptr<Formulation> make(const std::string& method, const std::string& formulation,
+                                    const Params& params) const override {
+    check_applies(method);
+    return pair(method).make(&p_, formulation, params);
+  }
+
+  std::unique_ptr<Formulation> make_unconstrained() const override {
+    if constexpr (HasMechanical<P>) {
+      return std::make_unique<UnconstrainedMechanical<std::decay_t<decltype(p_.mechanical())>>>(p_.mechanical());
+    } else if constexpr (requires { p_.state_space(); }) {
+      return std::make_unique<UnconstrainedAffine<std::decay_t<decltype(p_.state_space())>>>(p_.state_space());
+    } else {
+      return nullptr;
+    }
+  }
+
+  double energy(double t, const double* c) const override {
+    if constexpr (requires { p_.energy(t, c); }) return p_.energy(t, c);
+    return 0;
+  }
+  void first_integrals(double t, const double* c, double* out) const override {
+    if constexpr (requires { p_.first_integrals(t, c, out); }) p_.first_integrals(t, c, out);
+  }
+  bool reference(double t, double* c) const override {
+    if constexpr (requires { p_.reference(t, c); }) return p_.reference(t, c);
+    return false;
+  }
+
+  const P& concrete() const { return p_; }
+
+ private:
+  const PairOps& pair(const std::string& method) const { return pairs_.at(method_index(method)); }
+  void check_applies(const std::string& method) const {
+    const std::string why = why_not(method);
+    if (!why.empty()) throw UsageError("--method " + method + ": does not apply to problem '" +
+                                       info_.name + "': " + why);
+  }
+
+  P p_;
+  ProblemInfo info_;
+  std::vector<PairOps> pairs_;
+};
+
+// The methods Ms instantiated for P in the calling translation unit, for
+// models that live in a test rather than in problems/; the other methods of
+// the catalog say they were not instantiated for it.
+template <class P, class... Ms>
+std::unique_ptr<Problem> adapt_with_methods(P problem) {
+  std::vector<PairOps> pairs;
+  for (const auto& info : all_methods()) {
+    PairOps ops{[](const void*) { return std::string("not instantiated for this model"); }, nullptr, nullptr};
+    ((info.name == Ms::kName ? (ops = pair_ops<Ms, P>(), 0) : 0), ...);
+    pairs.push_back(ops);
+  }
+  return std::make_unique<ProblemAdapter<P>>(std::move(problem), std::move(pairs));
+}
+
+}  // namespace cstab
