@@ -18,7 +18,7 @@
 #                           run and its first 0.5 s                            (Fig. 3c)
 # Optional: -e "title='...'" prefixes every plot title; strobe (s) sets the
 # stroboscope interval (a multiple of the series' sampling); the geometry (H, lc,
-# l1, l2, h, a, b, hat) defaults to problems/biped.hpp (H = 1.78 m) and may be
+# l1, l2, h, a, b, hat) defaults to problems/biped/biped.hpp (H = 1.78 m) and may be
 # overridden the same way.
 #
 # Columns are looked up by name (header written by `cstab run`): t, x, y,
@@ -63,7 +63,7 @@ set linetype 7 lc rgb "#000000" lw 1.5
 set linetype 8 lc rgb "#999933" lw 1.5
 set linetype 9 lc rgb "#882255" lw 1.5
 
-# --- points of the stick figure (problems/biped.hpp) -------------------------
+# --- points of the stick figure (problems/biped/biped.hpp) -------------------------
 hipx(x, th) = x - lc * cos(th)
 hipy(y, th) = y - lc * sin(th)
 # Knee and ankle relative to the hip, the foot points relative to the ankle.

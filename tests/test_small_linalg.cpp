@@ -1,4 +1,4 @@
-// The fixed-size loops of methods/small_linalg.hpp against Eigen: the
+// The fixed-size loops of linalg/small_linalg.hpp against Eigen: the
 // Cholesky factor and solves against Eigen's LLT, the Schur-complement
 // constrained accelerations against a full-pivoting LU of the KKT system.
 #include <gtest/gtest.h>
