@@ -68,6 +68,10 @@ class Formulation : public OdeSystem {
   virtual bool has_post_step() const { return false; }
   virtual bool post_step(double /*t*/, double* /*y*/) { return false; }
 
+  // True where the constraints hold by construction (minimal coordinates):
+  // there is no manifold to leave, so a perturbed start means nothing.
+  virtual bool constraints_hold_by_construction() const { return false; }
+
   // Observables.
   virtual const std::vector<ConstraintInfo>& constraints() const = 0;
   virtual void residuals(double t, const double* y, double* out) const = 0;

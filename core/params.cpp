@@ -62,10 +62,6 @@ bool Params::has(const std::string& name) const {
   return std::any_of(values_.begin(), values_.end(), [&](const auto& nv) { return nv.first == name; });
 }
 
-bool Params::given(const std::string& name) const {
-  return std::find(given_.begin(), given_.end(), name) != given_.end();
-}
-
 std::string Params::describe() const {
   std::string out;
   for (const auto& [n, v] : values_) {
@@ -73,6 +69,16 @@ std::string Params::describe() const {
     out += n + "=" + format_short(v);
   }
   return out;
+}
+
+const ParamSpec* find_gain(const std::vector<ParamSpec>& specs) {
+  for (const auto& s : specs)
+    if (s.role != ParamRole::kSetting) return &s;
+  return nullptr;
+}
+
+double gain_rate(const ParamSpec& gain, double value) {
+  return gain.role == ParamRole::kTimeScale ? 1.0 / value : value;
 }
 
 }  // namespace cstab

@@ -19,12 +19,29 @@ struct UsageError : std::runtime_error {
 
 enum class Bound { kAny, kPositive, kNonNegative };
 
+// What a parameter is to the harness, so that stability maps, stress tables
+// and the report find "the gain" of any method without knowing its names.
+enum class ParamRole {
+  kSetting,    // anything else
+  kRate,       // a stabilization gain that is a decay rate (1/s): lambda, alpha
+  kTimeScale,  // a stabilization gain that is a time scale (s): rate = 1 / value
+};
+
 struct ParamSpec {
   std::string name;
   double default_value;
   Bound bound;
   std::string description;
+  ParamRole role = ParamRole::kSetting;
+  // Parameters that take the same value when this gain is swept (e.g.
+  // Baumgarte's beta with alpha: the repeated root -alpha).
+  std::vector<std::string> swept_with = {};
 };
+
+// The method's gain: its first kRate or kTimeScale parameter (nullptr if none).
+const ParamSpec* find_gain(const std::vector<ParamSpec>& specs);
+// The decay rate a gain value implies (value, or 1 / value for a time scale).
+double gain_rate(const ParamSpec& gain, double value);
 
 // Resolved parameter values: every declared name has a value.
 class Params {
@@ -39,8 +56,6 @@ class Params {
 
   double get(const std::string& name) const;
   bool has(const std::string& name) const;
-  // Whether the user set this parameter explicitly (not the default).
-  bool given(const std::string& name) const;
   // "a=1;b=2" in declaration order, for the summary's `params` column.
   std::string describe() const;
   const std::vector<std::pair<std::string, double>>& values() const { return values_; }

@@ -30,12 +30,31 @@ struct ProblemInfo {
   double default_t_end = 10;
   double reference_time = 0;                 // 0: no reference
   std::string reference_description;
+  // Largest fixed step that resolves the motion (0: no limit below the
+  // method's own setting); fast motions (wheel-sharp's contact point) need less.
+  double resolution_step = 0;
+};
+
+// How the shared conformance suite (tests/conformance/) runs a method: its
+// natural integrator and settings, and what it promises there. Declared by
+// the method (static ConformanceSettings conformance()); these are the defaults.
+struct ConformanceSettings {
+  std::string integrator = "rk8pd";
+  double tol = 1e-10;   // adaptive integrators: rtol = atol
+  double step = 1e-3;   // fixed-step integrators (at most the problem's resolution_step)
+  std::vector<std::pair<std::string, std::string>> params = {};
+  double time_scale_steps = 0;  // > 0: the method's time-scale gain is this many steps
+  bool stabilizes = true;       // false: residuals drift by design (none)
+  double residual_bound = 1e-6; // max |residual| from a consistent start; final |residual| from any
+  double drift_bound = 1e-4;    // max |residual| allowed to a method that does not stabilize
 };
 
 struct MethodInfo {
   std::string name;
   std::string description;
   std::vector<ParamSpec> params;
+  bool is_dae = false;  // a DAE formulation F(t, y, y') = 0: runs only on a DAE integrator
+  ConformanceSettings conformance = {};
 };
 
 class Problem {

@@ -254,8 +254,8 @@ RunResult run_case(const Problem& problem, const RunConfig& cfg, const std::stri
     throw UsageError("--perturb: method '" + cfg.method +
                      "' makes its initial values consistent before it starts (a DAE solver needs them), "
                      "so it cannot start off the manifold");
-  if (cfg.perturb > 0 && form->formulation_name() == "minimal")
-    throw UsageError("--perturb: the minimal formulation satisfies the constraints by construction; "
+  if (cfg.perturb > 0 && form->constraints_hold_by_construction())
+    throw UsageError("--perturb: the " + form->formulation_name() + " formulation satisfies the constraints by construction; "
                      "there is no manifold to leave");
   auto integrator = make_integrator(cfg.integrator, cfg.step);
   form->set_step_hint(integ_info.fixed_step ? cfg.step.step : 0.0);

@@ -58,25 +58,33 @@ double real_stability_boundary(const std::string& integrator) {
   return -inside;
 }
 
-double rate_of_gain(const std::string& gain_param, double gain) {
-  return gain_param == "dt" ? 1.0 / gain : gain;
+ParamSpec gain_spec(const Problem& problem, const StabilityConfig& cfg) {
+  const auto specs = problem.method_params(cfg.base.method, cfg.base.formulation);
+  if (cfg.gain_param.empty()) {
+    if (const ParamSpec* g = find_gain(specs)) return *g;
+    throw UsageError("--gain-param: method '" + cfg.base.method + "' declares no gain");
+  }
+  for (const auto& s : specs)
+    if (s.name == cfg.gain_param) return s;
+  throw UsageError("--gain-param " + cfg.gain_param + ": method '" + cfg.base.method + "' has no such parameter");
 }
 
 namespace {
 
 StabilityPoint run_point(const Problem& problem, const StabilityConfig& cfg, double h, double gain) {
+  const ParamSpec spec = gain_spec(problem, cfg);
   RunConfig rc = cfg.base;
   rc.step.step = h;
   rc.write_series = false;
   rc.ref_time = 0;
   const std::string value = format_short(gain);
-  rc.params.emplace_back(cfg.gain_param, value);
-  if (cfg.gain_param == "alpha") rc.params.emplace_back("beta", value);  // repeated root -alpha
+  rc.params.emplace_back(spec.name, value);
+  for (const auto& tied : spec.swept_with) rc.params.emplace_back(tied, value);  // e.g. beta = alpha
   const RunResult r = run_case(problem, rc, "");
   StabilityPoint p;
   p.step = h;
   p.gain = gain;
-  p.rate = rate_of_gain(cfg.gain_param, gain);
+  p.rate = gain_rate(spec, gain);
   p.status = r.status;
   p.max_residual = r.max_residual;
   p.final_residual = r.final_residual;
@@ -96,12 +104,13 @@ std::vector<StabilityPoint> stability_map(const Problem& problem, const Stabilit
 std::vector<StabilityBoundary> stability_boundaries(const Problem& problem, const StabilityConfig& cfg) {
   std::vector<StabilityBoundary> out;
   const double theory = real_stability_boundary(cfg.base.integrator);
+  const ParamSpec spec = gain_spec(problem, cfg);
   for (double h : cfg.steps) {
     // Bracket in h * rate around the theory, then bisect in log space.
     double lo = 0.25 * theory, hi = 4 * theory;  // in units of h * rate
     auto stable = [&](double hr) {
       const double rate = hr / h;
-      const double gain = cfg.gain_param == "dt" ? 1.0 / rate : rate;
+      const double gain = spec.role == ParamRole::kTimeScale ? 1.0 / rate : rate;
       return run_point(problem, cfg, h, gain).status == "ok";
     };
     if (!stable(lo) || stable(hi)) {

@@ -29,7 +29,7 @@ struct StabilityPoint {
 
 struct StabilityConfig {
   RunConfig base;              // problem, method, integrator, t_end, other params
-  std::string gain_param;      // lambda, alpha (sets alpha = beta), dt, ...
+  std::string gain_param;      // empty: the method's declared gain (ParamSpec::role)
   std::vector<double> steps;
   std::vector<double> gains;   // grid values
   int bisection_iterations = 10;  // boundary search per step size
@@ -43,8 +43,9 @@ struct StabilityBoundary {
   double theory = 0;         // real_stability_boundary(integrator)
 };
 
-// The decay rate a gain value implies for the method's residual dynamics.
-double rate_of_gain(const std::string& gain_param, double gain);
+// The gain a stability map sweeps: cfg.gain_param, or the method's declared
+// gain (find_gain) when that is empty. Throws UsageError if there is none.
+ParamSpec gain_spec(const Problem& problem, const StabilityConfig& cfg);
 
 std::vector<StabilityPoint> stability_map(const Problem& problem, const StabilityConfig& config);
 std::vector<StabilityBoundary> stability_boundaries(const Problem& problem, const StabilityConfig& config);

@@ -71,7 +71,8 @@ struct BaumgarteMethod : MechanicalMethod<BaumgarteMethod> {
   static constexpr const char* kDescription =
       "Baumgarte: Phi'' + 2 alpha Phi' + beta^2 Phi = 0, Psi' + gamma Psi = 0, KKT solve (full rank)";
   static std::vector<ParamSpec> generic_params() {
-    return {{"alpha", 10, Bound::kNonNegative, "damping of the holonomic residual (1/s)"},
+    return {{"alpha", 10, Bound::kNonNegative, "damping of the holonomic residual (1/s)", ParamRole::kRate,
+             {"beta"}},
             {"beta", 10, Bound::kNonNegative, "stiffness of the holonomic residual (1/s)"},
             {"gamma", 10, Bound::kNonNegative, "decay rate of the non-holonomic residual (1/s)"}};
   }

@@ -214,6 +214,8 @@ class MechanicalDaeFormulation final : public MechanicalFormulationBase<Model>, 
 
 struct IdaIndexOneMethod : MechanicalMethod<IdaIndexOneMethod> {
   static constexpr const char* kName = "ida-index1";
+  static constexpr bool kIsDae = true;  // F(t, y, y') = 0: needs a DAE integrator
+  static ConformanceSettings conformance() { return {.integrator = "ida", .tol = 1e-9}; }
   static constexpr const char* kDescription =
       "DAE for --integrator ida: [q, v, lambda], constraints at acceleration level (index 1); drifts at "
       "the tolerance (full rank)";
@@ -227,6 +229,8 @@ struct IdaIndexOneMethod : MechanicalMethod<IdaIndexOneMethod> {
 
 struct IdaGglMethod : MechanicalMethod<IdaGglMethod> {
   static constexpr const char* kName = "ida-ggl";
+  static constexpr bool kIsDae = true;
+  static ConformanceSettings conformance() { return {.integrator = "ida", .tol = 1e-9}; }
   static constexpr const char* kDescription =
       "DAE for --integrator ida: stabilized index-2 Gear-Gupta-Leimkuhler [q, v, lambda, mu], position and "
       "velocity constraints enforced (full rank)";

@@ -107,6 +107,9 @@ class IndexOneFormulation : public MechanicalFormulationBase<Model> {
 
 struct NoneMethod : MechanicalMethod<NoneMethod> {
   static constexpr const char* kName = "none";
+  // Not stabilized: the residual drifts, bounded over the suite's short
+  // horizon at rk8pd 1e-10, and does not recover from an inconsistent start.
+  static ConformanceSettings conformance() { return {.stabilizes = false, .drift_bound = 1e-4}; }
   static constexpr const char* kDescription =
       "index-1 ODE (constraints at acceleration level) with no stabilization: drift is visible";
   static std::vector<ParamSpec> generic_params() { return {}; }

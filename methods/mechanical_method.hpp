@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "core/params.hpp"
+#include "core/problem.hpp"
 #include "methods/mechanical.hpp"
 
 namespace cstab {

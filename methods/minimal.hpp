@@ -27,6 +27,7 @@ class MinimalFormulation final : public Formulation {
   explicit MinimalFormulation(const Model& model) : model_(model), constraints_(model.constraints()) {}
 
   std::string formulation_name() const override { return model_.formulation_name(); }
+  bool constraints_hold_by_construction() const override { return true; }
   int dimension() const override { return n; }
   void initial_state(double* y) const override {
     Vec<double, n> y0;

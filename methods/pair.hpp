@@ -5,7 +5,9 @@
 //
 // A method type M provides (see docs/extending.md):
 //   static constexpr const char* kName, kDescription;
-//   static std::vector<ParamSpec> generic_params();
+//   static std::vector<ParamSpec> generic_params();   // gains declare their ParamRole
+//   static constexpr bool kIsDae;                       // optional, default false
+//   static ConformanceSettings conformance();           // optional, defaults in core/problem.hpp
 //   template <class P> static std::string why_not(const P&);          // "" = applies
 //   template <class P> static std::vector<ParamSpec> params(const P&, const std::string& formulation);
 //   template <class P> static std::unique_ptr<Formulation> make(const P&, const std::string& formulation,
@@ -39,7 +41,10 @@ PairOps pair_ops() {
 
 template <class M>
 MethodInfo method_info() {
-  return {M::kName, M::kDescription, M::generic_params()};
+  MethodInfo info{M::kName, M::kDescription, M::generic_params()};
+  if constexpr (requires { M::kIsDae; }) info.is_dae = M::kIsDae;
+  if constexpr (requires { M::conformance(); }) info.conformance = M::conformance();
+  return info;
 }
 
 // The methods in the build, in the catalog's order (generated).

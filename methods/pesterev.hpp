@@ -13,6 +13,7 @@
 #include "core/format.hpp"
 #include "core/formulation.hpp"
 #include "core/params.hpp"
+#include "core/problem.hpp"
 #include "methods/affine.hpp"
 #include "methods/mechanical.hpp"
 #include "linalg/small_linalg.hpp"
@@ -171,8 +172,11 @@ struct PesterevMethod {
       "lambda-feedback: (d/dt + lambda)^r f = 0 per output, reactions from A(X) N + phi = 0 "
       "(Pesterev-Matrosov-Morozov); runs on the state-space form or on a mechanical model as an affine system";
   static std::vector<ParamSpec> generic_params() {
-    return {{"lambda", 1500, Bound::kPositive, "repeated root -lambda of every output's characteristic equation"}};
+    return {{"lambda", 1500, Bound::kPositive, "repeated root -lambda of every output's characteristic equation",
+             ParamRole::kRate}};
   }
+  // lambda = 50: the paper's 1500 is for h = 1e-5 and makes rk8pd stiff.
+  static ConformanceSettings conformance() { return {.params = {{"lambda", "50"}}}; }
 
   template <class P>
   static std::string why_not(const P&) {

@@ -109,6 +109,26 @@ TEST_P(FixedStepOrder, ObservedOrderIsFour) {
   EXPECT_LT(errors.back(), 1e-9);
 }
 
+// Explicit Euler: first order on the same closed forms. The end point t = 1
+// is on every grid (h = 2^-k / 20), so no side step enters the error.
+TEST(FixedStepOrderEuler, ObservedOrderIsOne) {
+  std::vector<double> errors, hs;
+  for (int k = 0; k < 5; ++k) {
+    const double h = 0.05 / std::pow(2.0, k);
+    const auto y = integrate("euler", StepSettings{h, 0, 0}, 1.0);
+    errors.push_back(max_error(y.data(), 1.0));
+    hs.push_back(h);
+  }
+  for (size_t k = 0; k + 1 < errors.size(); ++k) {
+    const double order = std::log(errors[k] / errors[k + 1]) / std::log(hs[k] / hs[k + 1]);
+    EXPECT_GE(order, 0.9) << "h=" << hs[k] << " e=" << errors[k] << " e/2=" << errors[k + 1];
+    EXPECT_LE(order, 1.1) << "h=" << hs[k] << " e=" << errors[k] << " e/2=" << errors[k + 1];
+  }
+  // Euler is far less accurate than RK4 at the same step (ordering).
+  const auto rk4 = integrate("rk4", StepSettings{hs.back(), 0, 0}, 1.0);
+  EXPECT_LT(max_error(rk4.data(), 1.0) * 1e3, errors.back());
+}
+
 // Off-grid output: state_at() from the last grid point must be O(h^4)
 // accurate, and must not disturb the trajectory.
 TEST_P(FixedStepOrder, SideStepIsFourthOrderAndHarmless) {

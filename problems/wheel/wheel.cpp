@@ -182,6 +182,7 @@ ProblemInfo Wheel::info() const {
       !description_.empty() ? description_
                             : "heavy hoop with a pendulum rolling without slip on z = x^4 + 0.13x^3 - 0.5x^2 - "
                               "0.13x + 0.5 (Pesterev-Matrosov-Morozov; curve and g = 9.81 per NOTES.md)";
+  info.resolution_step = resolution_step_;
   info.coordinates = {"x", "xdot", "z", "zdot", "theta", "thetadot", "phi", "phidot", "alpha"};
   info.formulations = {
       {"state-space", "the paper's affine form, 9 states, reactions [R_x, R_z, U]",

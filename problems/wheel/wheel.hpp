@@ -363,10 +363,11 @@ class Wheel {
   explicit Wheel(const WheelParameters& p) : params_(p), ss_(p), minimal_(p), mechanical_(p) {}
   // A variant of the wheel (other parameters) registered as a problem of its
   // own; it shares the wheel's instantiations (problems/wheel/wheel_sharp.hpp).
-  Wheel(const WheelParameters& p, std::string name, std::string description)
+  Wheel(const WheelParameters& p, std::string name, std::string description, double resolution_step)
       : Wheel(p) {
     name_ = std::move(name);
     description_ = std::move(description);
+    resolution_step_ = resolution_step;
   }
 
   ProblemInfo info() const;
@@ -380,6 +381,7 @@ class Wheel {
  private:
   WheelParameters params_;
   std::string name_, description_;  // empty: the paper's wheel
+  double resolution_step_ = 0;
   WheelStateSpace ss_;
   WheelMinimal minimal_;
   WheelMechanical mechanical_;
