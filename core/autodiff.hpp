@@ -16,15 +16,6 @@ using Dual = Eigen::AutoDiffScalar<Eigen::Matrix<Base, K, 1>>;
 template <class T>
 using Nest = Eigen::AutoDiffScalar<Eigen::Matrix<T, 1, 1>>;
 
-template <class Base, int L>
-struct NestN {
-  using type = Nest<typename NestN<Base, L - 1>::type>;
-};
-template <class Base>
-struct NestN<Base, 0> {
-  using type = Base;
-};
-
 // Value of a (possibly nested) scalar at the level of Base.
 template <class Base, class T>
 Base collapse(const T& x) {
@@ -40,16 +31,6 @@ template <class Base, class T>
 void extract_levels(const T& x, Base* out) {
   out[0] = collapse<Base>(x);
   if constexpr (!std::is_same_v<T, Base>) extract_levels<Base>(x.derivatives()(0), out + 1);
-}
-
-// Gradient of a scalar function f(Eigen::Matrix<Dual<N>,N,1>) at x.
-template <int N, class F>
-double gradient(const F& f, const Eigen::Matrix<double, N, 1>& x, Eigen::Matrix<double, N, 1>& grad) {
-  Eigen::Matrix<Dual<N>, N, 1> xd;
-  for (int i = 0; i < N; ++i) xd(i) = Dual<N>(x(i), N, i);
-  const Dual<N> r = f(xd);
-  grad = r.derivatives();
-  return r.value();
 }
 
 }  // namespace cstab::ad

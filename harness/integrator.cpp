@@ -200,8 +200,7 @@ std::string gsl_failure_words(int status, double t, double h) {
 // GSL odeiv2 adaptive schemes, driven one step at a time via evolve_apply.
 class GslAdaptive final : public Integrator {
  public:
-  GslAdaptive(const gsl_odeiv2_step_type* type, const StepSettings& s, bool needs_jacobian)
-      : type_(type), settings_(s), needs_jacobian_(needs_jacobian) {}
+  GslAdaptive(const gsl_odeiv2_step_type* type, const StepSettings& s) : type_(type), settings_(s) {}
   ~GslAdaptive() override { release(); }
 
   void start(OdeSystem& sys, double t0, const double* y0) override {
@@ -283,7 +282,6 @@ class GslAdaptive final : public Integrator {
 
   const gsl_odeiv2_step_type* type_;
   StepSettings settings_;
-  bool needs_jacobian_;
   gsl_odeiv2_system gsys_{};
   gsl_odeiv2_driver* driver_ = nullptr;
   double h_ = 0;
@@ -310,10 +308,10 @@ std::unique_ptr<Integrator> make_integrator(const std::string& name, const StepS
   if (name == "euler") return std::make_unique<Euler>(s.step);
   if (name == "rk4") return std::make_unique<Rk4>(s.step);
   if (name == "adams") return std::make_unique<AdamsPece>(s.step);
-  if (name == "rk8pd") return std::make_unique<GslAdaptive>(gsl_odeiv2_step_rk8pd, s, false);
-  if (name == "rkf45") return std::make_unique<GslAdaptive>(gsl_odeiv2_step_rkf45, s, false);
-  if (name == "msadams") return std::make_unique<GslAdaptive>(gsl_odeiv2_step_msadams, s, false);
-  if (name == "msbdf") return std::make_unique<GslAdaptive>(gsl_odeiv2_step_msbdf, s, true);
+  if (name == "rk8pd") return std::make_unique<GslAdaptive>(gsl_odeiv2_step_rk8pd, s);
+  if (name == "rkf45") return std::make_unique<GslAdaptive>(gsl_odeiv2_step_rkf45, s);
+  if (name == "msadams") return std::make_unique<GslAdaptive>(gsl_odeiv2_step_msadams, s);
+  if (name == "msbdf") return std::make_unique<GslAdaptive>(gsl_odeiv2_step_msbdf, s);
   if (name == "ida") return make_ida_integrator(s);
   throw UsageError("--integrator " + name + ": not constructible");
 }

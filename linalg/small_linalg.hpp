@@ -2,7 +2,7 @@
 // (4..12 coordinates, 2..9 constraint rows), as plain loops with
 // compile-time bounds. Eigen's LLT and triangular solves on fixed-size
 // matrices of these sizes dispatch to its blocked (BLAS-like) kernels with
-// packing, which dominated the right-hand sides in the profile (README,
+// packing, which dominated the right-hand sides in the profile (docs/measurements.md,
 // Speed); these loops compute the same factorization (tests/test_small_linalg.cpp
 // checks them against Eigen's LLT and against a KKT solve).
 #pragma once
@@ -114,7 +114,7 @@ class SchurSolver {
     // C^T = L^-1 A^T by forward substitution on whole rows: the NC columns
     // advance together (independent, vectorizable chains). One triangular
     // solve per column was latency-bound and took ~40 % of the andrews and
-    // ball right-hand sides (README, Speed).
+    // ball right-hand sides (docs/measurements.md, Speed).
     const auto& L = mass_.L();
     S_.setZero();
     for (int i = 0; i < NQ; ++i) {

@@ -74,7 +74,7 @@ class PesterevFormulation final : public AffineFormulationBase<Model> {
     for (int i = 0; i < m; ++i) phi(i) += jet_.lower.row(i).dot(gains_.row(i));
     lu_.compute(jet_.A);
     // Singularity check from the LU pivots (min |U_ii| / max |U_ii|): the
-    // 1-norm rcond estimate cost a third of this right-hand side (README, Speed).
+    // 1-norm rcond estimate cost a third of this right-hand side (docs/measurements.md, Speed).
     const double ratio = pesterev_detail::lu_pivot_ratio(lu_);
     if (!(ratio > 1e-14)) {
       this->failure_ = "reaction matrix A(X) singular (LU pivot ratio " + format_3g(ratio) + ") at t = " +

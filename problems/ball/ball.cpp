@@ -1,7 +1,5 @@
 #include "problems/ball/ball.hpp"
 
-#include <gsl/gsl_errno.h>
-#include <gsl/gsl_odeiv2.h>
 
 namespace cstab {
 
@@ -212,35 +210,6 @@ void Ball::first_integrals(double, const double* c, double* out) const {
   out[1] = c[14] * ca * ca + 2 * params_.r / (7 * params_.rc()) * spin * std::sin(c[1]);
 }
 
-namespace {
-int newton_euler_gsl_rhs(double t, const double y[], double dydt[], void* model) {
-  constexpr int n = BallNewtonEuler::kStates;
-  Vec<double, n> dy;
-  static_cast<const BallNewtonEuler*>(model)->rhs(t, Eigen::Map<const Vec<double, n>>(y).eval(), dy);
-  vmap<n>(dydt) = dy;
-  return GSL_SUCCESS;
-}
-}  // namespace
-
-bool Ball::reference(double t, double* canonical) const {
-  constexpr int n = BallNewtonEuler::kStates;
-  std::lock_guard<std::mutex> lock(cache_->mutex);
-  auto it = cache_->states.find(t);
-  if (it == cache_->states.end()) {
-    gsl_odeiv2_system sys{newton_euler_gsl_rhs, nullptr, n, const_cast<BallNewtonEuler*>(&minimal_)};
-    gsl_odeiv2_driver* d = gsl_odeiv2_driver_alloc_y_new(&sys, gsl_odeiv2_step_rk8pd, 1e-6, 1e-13, 1e-13);
-    Vec<double, n> y;
-    minimal_.initial_state(y);
-    double t0 = 0;
-    const int status = gsl_odeiv2_driver_apply(d, &t0, t, y.data());
-    gsl_odeiv2_driver_free(d);
-    if (status != GSL_SUCCESS) return false;
-    std::vector<double> c(24);
-    minimal_.to_canonical(t, y, c.data());
-    it = cache_->states.emplace(t, std::move(c)).first;
-  }
-  std::copy(it->second.begin(), it->second.end(), canonical);
-  return true;
-}
+bool Ball::reference(double t, double* canonical) const { return reference_.at(t, canonical); }
 
 }  // namespace cstab

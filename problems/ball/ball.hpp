@@ -62,6 +62,7 @@
 #include "core/autodiff.hpp"
 #include "core/formulation.hpp"
 #include "core/problem.hpp"
+#include "problems/common/reference_cache.hpp"
 #include "methods/affine.hpp"
 
 namespace cstab {
@@ -307,11 +308,7 @@ class Ball {
   BallParameters params_;
   BallMechanical mechanical_;
   BallNewtonEuler minimal_;
-  struct Cache {
-    std::mutex mutex;
-    std::map<double, std::vector<double>> states;
-  };
-  std::shared_ptr<Cache> cache_ = std::make_shared<Cache>();
+  ReferenceCache reference_ = reference_cache_of(minimal_, 24);
 };
 
 }  // namespace cstab

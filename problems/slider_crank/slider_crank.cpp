@@ -1,7 +1,5 @@
 #include "problems/slider_crank/slider_crank.hpp"
 
-#include <gsl/gsl_errno.h>
-#include <gsl/gsl_odeiv2.h>
 
 namespace cstab {
 
@@ -121,34 +119,6 @@ ProblemInfo SliderCrank::info() const {
   return info;
 }
 
-namespace {
-int crank_gsl_rhs(double t, const double y[], double dydt[], void* model) {
-  Vec<double, 2> dy;
-  static_cast<const SliderCrankMinimal*>(model)->rhs(t, Vec<double, 2>(y[0], y[1]), dy);
-  dydt[0] = dy(0);
-  dydt[1] = dy(1);
-  return GSL_SUCCESS;
-}
-}  // namespace
-
-bool SliderCrank::reference(double t, double* canonical) const {
-  std::lock_guard<std::mutex> lock(cache_->mutex);
-  auto it = cache_->states.find(t);
-  if (it == cache_->states.end()) {
-    gsl_odeiv2_system sys{crank_gsl_rhs, nullptr, 2, const_cast<SliderCrankMinimal*>(&minimal_)};
-    gsl_odeiv2_driver* d = gsl_odeiv2_driver_alloc_y_new(&sys, gsl_odeiv2_step_rk8pd, 1e-6, 1e-13, 1e-13);
-    Vec<double, 2> y;
-    minimal_.initial_state(y);
-    double t0 = 0;
-    const int status = gsl_odeiv2_driver_apply(d, &t0, t, y.data());
-    gsl_odeiv2_driver_free(d);
-    if (status != GSL_SUCCESS) return false;
-    std::vector<double> c(6);
-    minimal_.to_canonical(t, y, c.data());
-    it = cache_->states.emplace(t, std::move(c)).first;
-  }
-  std::copy(it->second.begin(), it->second.end(), canonical);
-  return true;
-}
+bool SliderCrank::reference(double t, double* canonical) const { return reference_.at(t, canonical); }
 
 }  // namespace cstab

@@ -37,6 +37,7 @@
 #include "core/autodiff.hpp"
 #include "core/formulation.hpp"
 #include "core/problem.hpp"
+#include "problems/common/reference_cache.hpp"
 #include "methods/affine.hpp"
 #include "problems/common/trig_rows.hpp"
 
@@ -160,11 +161,7 @@ class SliderCrank {
   SliderCrankParameters params_;
   SliderCrankMinimal minimal_;
   SliderCrankMechanical mechanical_;
-  struct Cache {
-    std::mutex mutex;
-    std::map<double, std::vector<double>> states;
-  };
-  std::shared_ptr<Cache> cache_ = std::make_shared<Cache>();
+  ReferenceCache reference_ = reference_cache_of(minimal_, 6);
 };
 
 }  // namespace cstab

@@ -1,7 +1,5 @@
 #include "problems/wheel/wheel.hpp"
 
-#include <gsl/gsl_errno.h>
-#include <gsl/gsl_odeiv2.h>
 
 #include "core/autodiff.hpp"
 
@@ -209,33 +207,6 @@ double Wheel::energy(double, const double* c) const {
   return T + V;
 }
 
-namespace {
-int minimal_gsl_rhs(double t, const double y[], double dydt[], void* model) {
-  Vec<double, WheelMinimal::kStates> dy;
-  static_cast<const WheelMinimal*>(model)->rhs(t, Eigen::Map<const Vec<double, 5>>(y).eval(), dy);
-  vmap<5>(dydt) = dy;
-  return GSL_SUCCESS;
-}
-}  // namespace
-
-bool Wheel::reference(double t, double* canonical) const {
-  std::lock_guard<std::mutex> lock(cache_->mutex);
-  auto it = cache_->states.find(t);
-  if (it == cache_->states.end()) {
-    gsl_odeiv2_system sys{minimal_gsl_rhs, nullptr, 5, const_cast<WheelMinimal*>(&minimal_)};
-    gsl_odeiv2_driver* d = gsl_odeiv2_driver_alloc_y_new(&sys, gsl_odeiv2_step_rk8pd, 1e-6, 1e-13, 1e-13);
-    Vec<double, 5> y;
-    minimal_.initial_state(y);
-    double t0 = 0;
-    const int status = gsl_odeiv2_driver_apply(d, &t0, t, y.data());
-    gsl_odeiv2_driver_free(d);
-    if (status != GSL_SUCCESS) return false;
-    std::vector<double> c(9);
-    minimal_.to_canonical(t, y, c.data());
-    it = cache_->states.emplace(t, std::move(c)).first;
-  }
-  std::copy(it->second.begin(), it->second.end(), canonical);
-  return true;
-}
+bool Wheel::reference(double t, double* canonical) const { return reference_.at(t, canonical); }
 
 }  // namespace cstab

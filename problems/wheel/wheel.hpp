@@ -27,6 +27,7 @@
 #include "core/formulation.hpp"
 #include "core/autodiff.hpp"
 #include "core/problem.hpp"
+#include "problems/common/reference_cache.hpp"
 #include "methods/affine.hpp"
 
 namespace cstab {
@@ -123,7 +124,7 @@ class WheelStateSpace {
 
   // The Lie-derivative jet (LieJet) in closed form: about a third of the
   // cost of nested AD, which dominated the state-space right-hand side
-  // (README, Speed). With xa = x + r cos(alpha), P_k = p^(k)(xa):
+  // (docs/measurements.md, Speed). With xa = x + r cos(alpha), P_k = p^(k)(xa):
   //   L_F f1 = zdot - P1 xdot,  L_F^2 f1 = F_zd - P1 F_xd - P2 xdot^2,
   //   L_B L_F f1 = -P1 B_xd + B_zd + P2 r sin(alpha) xdot B_alpha,
   //   L_F f2 = -sin(alpha) F_xd + cos(alpha) F_zd,
@@ -385,11 +386,7 @@ class Wheel {
   WheelStateSpace ss_;
   WheelMinimal minimal_;
   WheelMechanical mechanical_;
-  struct Cache {
-    std::mutex mutex;
-    std::map<double, std::vector<double>> states;
-  };
-  std::shared_ptr<Cache> cache_ = std::make_shared<Cache>();
+  ReferenceCache reference_ = reference_cache_of(minimal_, 9);
 };
 
 }  // namespace cstab
