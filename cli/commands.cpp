@@ -242,7 +242,7 @@ CommandLine::CommandLine() {
   for (const auto& c : commands()) {
     CLI::App* sub = app.add_subcommand(c.name, c.summary);
     sub->group("Commands");
-    if (*c.footer) sub->footer(c.footer);
+    sub->footer(c.footer);  // also when empty: a subcommand starts with the top-level footer
     args.push_back(std::make_unique<Args>(*sub));
     c.declare(*args.back());
   }
