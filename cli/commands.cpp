@@ -324,7 +324,7 @@ std::string usage() {
 }
 
 std::string command_help(const std::string& command) {
-  if (command == "help" || !known_command(command))
+  if (!known_command(command))
     throw UsageError("unknown command '" + command + "' (known: " + command_names() + ")");
   const CommandLine cli;
   return cli.app.get_subcommand(command)->help("cstab");

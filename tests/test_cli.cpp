@@ -554,6 +554,7 @@ TEST(CliHelp, EveryCommandListsExactlyItsOptionsWithADescriptionEach) {
     EXPECT_EQ(o.code, 0) << o.err;
     EXPECT_TRUE(o.err.empty()) << o.err;
     EXPECT_NE(o.out.find("usage: cstab " + command), std::string::npos) << o.out;
+    EXPECT_EQ(o.out.find("`cstab COMMAND --help`"), std::string::npos) << "the top-level footer:\n" << o.out;
     std::set<std::string> listed;
     for (const auto& opt : help_options(o.out)) {
       EXPECT_FALSE(opt.description.empty()) << opt.name << " has no description";
@@ -603,6 +604,9 @@ TEST(CliHelp, TopLevelHelpListsEveryCommand) {
   }
   EXPECT_EQ(run_cli({"help"}, s.dir()).out, help.out);
   EXPECT_EQ(run_cli({"help"}, s.dir()).code, 0);
+  const Outcome help_help = run_cli({"help", "help"}, s.dir());
+  EXPECT_EQ(help_help.code, 0) << help_help.err;
+  EXPECT_NE(help_help.out.find("usage: cstab help [OPTIONS] [COMMAND]"), std::string::npos) << help_help.out;
   EXPECT_EQ(run_cli({"-h"}, s.dir()).out, help.out);
   const Outcome bare = run_cli({}, s.dir());  // no command: the same text, but exit 2
   EXPECT_EQ(bare.code, 2);
