@@ -131,10 +131,13 @@ std::vector<double> Args::number_list(const std::string& name) const {
 }
 
 double Args::end_time(const std::string& name, const ProblemInfo& problem) const {
-  const std::string text = require(name);
+  return resolve_end_time(require(name), problem, name);
+}
+
+double resolve_end_time(const std::string& text, const ProblemInfo& problem, const std::string& option) {
   if (text == "ref") return problem.reference_time > 0 ? problem.reference_time : problem.default_t_end;
   if (text == "default") return problem.default_t_end;
-  return parse_finite_double(text, name);
+  return parse_finite_double(text, option);
 }
 
 std::vector<std::pair<std::string, std::string>> Args::pairs(const std::string& name) const {

@@ -56,9 +56,7 @@ class Args {
   long integer(const std::string& name) const;
   // Comma-separated, across every occurrence.
   std::vector<double> number_list(const std::string& name) const;
-  // A number, "ref" (the problem's reference time, or its default horizon if
-  // it has none: as matrix files read t_end = "ref") or "default" (the
-  // problem's default horizon).
+  // resolve_end_time (below) of the value.
   double end_time(const std::string& name, const ProblemInfo& problem) const;
   // --param name=value pairs.
   std::vector<std::pair<std::string, std::string>> pairs(const std::string& name) const;
@@ -80,5 +78,11 @@ class Args {
   std::map<std::string, std::vector<std::string>> values_;  // node-based: CLI11 keeps pointers into it
   std::map<std::string, Declared> declared_;
 };
+
+// `text` as an end time for `problem`: a finite number, "ref" (the
+// problem's reference time, or its default horizon if it has none: as
+// matrix files read t_end = "ref") or "default" (its default horizon).
+// Errors name `option`.
+double resolve_end_time(const std::string& text, const ProblemInfo& problem, const std::string& option);
 
 }  // namespace cstab::cli

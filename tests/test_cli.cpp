@@ -3,6 +3,8 @@
 // writes summary.csv and series.csv with the documented columns.
 #include <gtest/gtest.h>
 
+#include "cli/args.hpp"
+#include "core/problem.hpp"
 #include "problems/registry.hpp"
 #include "tests/test_util.hpp"
 #include <sys/wait.h>
@@ -644,6 +646,29 @@ Csv summary_of(const std::vector<std::string>& args, const fs::path& scratch, co
   const Outcome o = run_cli(a, scratch);
   EXPECT_EQ(o.code, 0) << o.err;
   return read_csv(out / "summary.csv");
+}
+
+// The same words as matrix files: "ref" falls back to the default horizon
+// for a problem without a reference (none of the registered ones today).
+TEST(Args, EndTimeWordsAndNumbers) {
+  cstab::ProblemInfo with_ref, without_ref;
+  with_ref.reference_time = 3;
+  with_ref.default_t_end = 20;
+  without_ref.default_t_end = 7;
+  using cstab::cli::resolve_end_time;
+  EXPECT_EQ(resolve_end_time("ref", with_ref, "--t-end"), 3);
+  EXPECT_EQ(resolve_end_time("default", with_ref, "--t-end"), 20);
+  EXPECT_EQ(resolve_end_time("ref", without_ref, "--t-end"), 7);
+  EXPECT_EQ(resolve_end_time("default", without_ref, "--t-end"), 7);
+  EXPECT_EQ(resolve_end_time("0.25", with_ref, "--t-end"), 0.25);
+  for (const char* bad : {"REF", "reference", "ref ", "", "nan", "inf", "2s"}) {
+    try {
+      resolve_end_time(bad, with_ref, "--t-end");
+      ADD_FAILURE() << "accepted '" << bad << "'";
+    } catch (const cstab::UsageError& e) {
+      EXPECT_EQ(std::string(e.what()).rfind("--t-end: ", 0), 0u) << e.what();
+    }
+  }
 }
 
 TEST(Cli, TEndRefIsTheProblemsReferenceTime) {
