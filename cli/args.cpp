@@ -63,9 +63,12 @@ void Args::check() const {
   for (const auto& [name, values] : values_) {
     // CLI11 gives an option without a value the next argument, even an
     // option ("--blowup --out DIR", "--blowup= --out DIR").
-    for (const auto& v : values)
-      if (name.rfind("--", 0) == 0 && declared_.count(v.substr(0, v.find('='))))
+    for (const auto& v : values) {
+      const std::string word = v.substr(0, v.find('='));
+      if (name.rfind("--", 0) == 0 && word.rfind("-", 0) == 0 &&
+          (declared_.count(word) || word == "--help" || word == "-h"))
         throw UsageError(name + ": missing value (the next argument, " + v + ", is an option)");
+    }
     if (values.size() > 1 && !declared(name).repeatable) throw UsageError(name + ": given more than once");
   }
 }

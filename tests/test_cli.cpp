@@ -193,6 +193,8 @@ std::vector<BadCase> bad_cases() {
       {"t_end_word", with(kGood, "--t-end", "reference"), "--t-end"},
       {"t_end_ref_trailing", with(kGood, "--t-end", "ref "), "--t-end"},
       {"value_missing_before_option", [] { auto a = kGood; a.push_back("--blowup"); return a; }(), "--blowup"},
+      {"value_missing_before_help", [] { auto a = kGood; a.insert(a.end(), {"--formulation", "--help"}); return a; }(),
+       "--formulation: missing value"},
       {"inline_empty_value", [] { auto a = kGood; a.push_back("--blowup="); return a; }(), "--blowup: missing value"},
       {"unknown_inline_option", [] { auto a = kGood; a.push_back("--no-such=3"); return a; }(),
        "--no-such: unknown option"},
