@@ -1,12 +1,15 @@
 #include "cli/commands.hpp"
 
+#include <CLI/CLI.hpp>
+
 #include <iostream>
+#include <memory>
 #include <sstream>
 
 #include "cli/args.hpp"
 #include "cli/gate_command.hpp"
-#include "cli/stability_command.hpp"
 #include "cli/matrix_commands.hpp"
+#include "cli/stability_command.hpp"
 #include "core/format.hpp"
 #include "harness/integrator.hpp"
 #include "harness/run.hpp"
@@ -14,34 +17,6 @@
 #include "problems/registry.hpp"
 
 namespace cstab::cli {
-
-std::string usage() {
-  return R"(cstab - benchmark and verification suite for constraint stabilization methods
-
-usage:
-  cstab list
-  cstab run --problem P --method M [--formulation F] [--param name=value ...]
-            --integrator I (--step H | --rtol R --atol A) --t-end T
-            [--times t1,t2,...] [--sample-every DT] [--ref-time T]
-            [--blowup B] [--observe-every N] [--perturb DELTA]
-            [--recovery-threshold R] [--drift-fit-from T] --out DIR
-  cstab stability --problem P --method M --integrator I --gain-param NAME
-            --steps h1,h2,... --gains g1,g2,... --t-end T --out DIR [--param k=v ...]
-  cstab matrix [FILE] --out DIR [--jobs N] [--shard k/N] [--filter S] [--force]
-               [--no-report] [--list] [--print-default]
-               runs a benchmark matrix (default: the embedded one; docs/matrix.md)
-  cstab merge OUT SHARD_DIR... [--jobs N] [--no-report]
-  cstab report DIR [--jobs N] [--no-plots]
-  cstab gate [--thresholds FILE] [--csv OUT] DIR
-               checks a matrix results folder against accuracy thresholds (docs/gate.md);
-               exit 1 if any check fails
-  cstab gate --update [--factor F] [--time-factor T] [--thresholds FILE] DIR
-  cstab gate --init FILE [--factor F] DIR
-
-Exit codes: 0 success (a diverged run is a recorded result), 2 bad input, 1 internal error.
-See README.md for every column of summary.csv and series.csv.
-)";
-}
 
 namespace {
 
@@ -53,9 +28,17 @@ std::string bound_text(Bound b) {
   }
 }
 
-int cmd_list(const std::vector<std::string>& argv) {
-  Args args(argv, {});
-  if (!args.positional().empty()) throw UsageError("list: unexpected argument '" + args.positional()[0] + "'");
+// Names of the integrators that take --step (fixed) or --rtol/--atol.
+std::string integrator_names(bool fixed_step) {
+  std::string names;
+  for (const auto& i : all_integrators())
+    if (i.fixed_step == fixed_step) names += (names.empty() ? "" : ", ") + i.name;
+  return names;
+}
+
+void declare_list(Args&) {}
+
+int cmd_list(const Args&) {
   std::ostringstream out;
   out << "PROBLEMS\n";
   for (const auto& p : all_problems()) {
@@ -97,13 +80,45 @@ int cmd_list(const std::vector<std::string>& argv) {
   return 0;
 }
 
-int cmd_run(const std::vector<std::string>& argv) {
-  Args args(argv,
-            {"--problem", "--method", "--formulation", "--param", "--integrator", "--step", "--rtol", "--atol",
-             "--t-end", "--times", "--sample-every", "--ref-time", "--blowup", "--observe-every", "--out",
-             "--perturb", "--recovery-threshold", "--drift-fit-from"},
-            {"--no-series"}, {"--param", "--times"});
-  if (!args.positional().empty()) throw UsageError("run: unexpected argument '" + args.positional()[0] + "'");
+void declare_run(Args& a) {
+  const RunConfig d;
+  declare_case_options(a);
+  a.value("--step", "H", "fixed step, for " + integrator_names(true))
+      .value("--rtol", "R", "relative tolerance, for " + integrator_names(false))
+      .value("--atol", "A", "absolute tolerance, with --rtol")
+      .repeatable("--times", "T1,T2,...", "extra series rows at exactly these times, in (0, t_end]")
+      .value("--sample-every", "DT", "one series row per DT of time (0: t_end/1000)", format_short(d.sample_every))
+      .value("--ref-time", "T", "time of the error against the reference; 0: none (default: the problem's, if <= t_end)")
+      .value("--blowup", "B", "residual above which the run is recorded as diverged", format_short(d.blowup))
+      .value("--observe-every", "N", "evaluate the metrics every N steps (output rows always)",
+             std::to_string(d.observe_every))
+      .value("--perturb", "DELTA", "start off the constraint manifold by DELTA (README, Stress)",
+             format_short(d.perturb))
+      .value("--recovery-threshold", "R", "residual a perturbed run must return to and stay below",
+             format_short(d.recovery_threshold))
+      .value("--drift-fit-from", "T", "fit the drift growth exponent over [T, t_end] (if t_end >= 4 T; 0: no fit)",
+             format_short(d.drift_fit_from))
+      .flag("--no-series", "write summary.csv only, no series.csv")
+      .required("--out", "DIR", "output folder (created if missing)");
+}
+
+// --step, or --rtol and --atol, as the integrator needs.
+StepSettings step_settings(const Args& args, const IntegratorInfo& integ) {
+  StepSettings s;
+  if (integ.fixed_step) {
+    if (args.has("--rtol") || args.has("--atol"))
+      throw UsageError("--rtol/--atol: integrator '" + integ.name + "' is fixed-step; give --step");
+    s.step = parse_finite_double(args.require("--step"), "--step");
+  } else {
+    if (args.has("--step"))
+      throw UsageError("--step: integrator '" + integ.name + "' is adaptive; give --rtol and --atol");
+    s.rtol = parse_finite_double(args.require("--rtol"), "--rtol");
+    s.atol = parse_finite_double(args.require("--atol"), "--atol");
+  }
+  return s;
+}
+
+int cmd_run(const Args& args) {
   RunConfig cfg;
   cfg.problem = args.require("--problem");
   cfg.method = args.require("--method");
@@ -111,34 +126,24 @@ int cmd_run(const std::vector<std::string>& argv) {
   cfg.integrator = args.require("--integrator");
   const Problem& problem = find_problem(cfg.problem);
   const IntegratorInfo& integ = find_integrator(cfg.integrator);
-  for (const auto& kv : args.all("--param")) {
-    const auto eq = kv.find('=');
-    if (eq == std::string::npos || eq == 0) throw UsageError("--param " + kv + ": expected name=value");
-    cfg.params.emplace_back(kv.substr(0, eq), kv.substr(eq + 1));
-  }
-  if (integ.fixed_step) {
-    if (args.has("--rtol") || args.has("--atol"))
-      throw UsageError("--rtol/--atol: integrator '" + integ.name + "' is fixed-step; give --step");
-    cfg.step.step = parse_finite_double(args.require("--step"), "--step");
-  } else {
-    if (args.has("--step")) throw UsageError("--step: integrator '" + integ.name + "' is adaptive; give --rtol and --atol");
-    cfg.step.rtol = parse_finite_double(args.require("--rtol"), "--rtol");
-    cfg.step.atol = parse_finite_double(args.require("--atol"), "--atol");
-  }
-  cfg.t_end = parse_finite_double(args.require("--t-end"), "--t-end");
+  cfg.params = args.pairs("--param");
+  cfg.step = step_settings(args, integ);
+  cfg.t_end = args.end_time("--t-end", problem.info());
   cfg.times = args.number_list("--times");
-  cfg.sample_every = args.number("--sample-every", 0);
-  cfg.ref_time = args.number("--ref-time", -1);
-  if (args.has("--ref-time") && !(cfg.ref_time >= 0 && cfg.ref_time <= cfg.t_end))
-    throw UsageError("--ref-time: must be in [0, t_end] (0: no reference error)");
-  cfg.blowup = args.number("--blowup", 1e3);
-  const long observe_every = args.integer("--observe-every", 1);
+  cfg.sample_every = args.number("--sample-every");
+  if (args.has("--ref-time")) {
+    cfg.ref_time = args.number("--ref-time");
+    if (!(cfg.ref_time >= 0 && cfg.ref_time <= cfg.t_end))
+      throw UsageError("--ref-time: must be in [0, t_end] (0: no reference error)");
+  }
+  cfg.blowup = args.number("--blowup");
+  const long observe_every = args.integer("--observe-every");
   if (observe_every < 1 || observe_every > 1000000000) throw UsageError("--observe-every: must be in [1, 1e9]");
   cfg.observe_every = int(observe_every);
   cfg.write_series = !args.has("--no-series");
-  cfg.perturb = args.number("--perturb", 0);
-  cfg.recovery_threshold = args.number("--recovery-threshold", 1e-10);
-  cfg.drift_fit_from = args.number("--drift-fit-from", 10);
+  cfg.perturb = args.number("--perturb");
+  cfg.recovery_threshold = args.number("--recovery-threshold");
+  cfg.drift_fit_from = args.number("--drift-fit-from");
   const std::string out = args.require("--out");
 
   const RunResult r = run_case(problem, cfg, out);
@@ -152,17 +157,208 @@ int cmd_run(const std::vector<std::string>& argv) {
   return 0;
 }
 
+// ---------------------------------------------------------------- the table
+
+struct Command {
+  const char* name;
+  const char* summary;  // one line, in `cstab --help` and atop `cstab NAME --help`
+  const char* footer;   // after the options in `cstab NAME --help`; may be empty
+  void (*declare)(Args&);
+  int (*run)(const Args&);
+};
+
+const std::vector<Command>& commands() {
+  static const std::vector<Command> table = {
+      {"list", "List the problems (formulations, constraints, reference), methods (--param defaults), integrators",
+       "", declare_list, cmd_list},
+      {"run", "Run one case; write DIR/summary.csv and DIR/series.csv (README.md: every column)",
+       "A diverged run is a recorded result (exit 0; its status says so).", declare_run, cmd_run},
+      {"stability", "Step x gain map of a method and its measured stability boundary per step",
+       "Writes DIR/stability.csv, DIR/boundary.csv and, with gnuplot, DIR/stability.png/.svg.", declare_stability,
+       cmd_stability},
+      {"matrix", "Run a benchmark matrix (default: the embedded one; docs/matrix.md)",
+       "Exit 128+N if interrupted by signal N (finished cases are kept; run again to resume).", declare_matrix,
+       cmd_matrix},
+      {"merge", "Join the shard folders of one matrix into OUT and build its report",
+       "Exit 3 if cases of the matrix are missing from the shards.", declare_merge, cmd_merge},
+      {"report", "Rebuild the report (tables, plots, report.html) of a matrix results folder", "", declare_report,
+       cmd_report},
+      {"gate", "Check a matrix results folder against accuracy thresholds (docs/gate.md)",
+       "Exit 1 if any check fails. --update and --init write thresholds instead of checking.", declare_gate,
+       cmd_gate},
+  };
+  return table;
+}
+
+std::string command_names() {
+  std::string names;
+  for (const auto& c : commands()) names += (names.empty() ? "" : ", ") + std::string(c.name);
+  return names;
+}
+
+bool known_command(const std::string& name) {
+  if (name == "help") return true;
+  for (const auto& c : commands())
+    if (name == c.name) return true;
+  return false;
+}
+
+// The whole command line: the top-level app, one subcommand per command
+// (with its Args) and `help`.
+struct CommandLine {
+  CLI::App app{"cstab - benchmark and verification suite for constraint stabilization methods", "cstab"};
+  std::vector<std::unique_ptr<Args>> args;  // in the order of commands()
+  CLI::App* help = nullptr;
+  std::string help_topic;
+
+  CommandLine();
+  // The subcommand being parsed or parsed, else the top-level app.
+  const CLI::App& selected() const {
+    const auto chosen = app.get_subcommands();
+    return chosen.empty() ? app : *chosen.front();
+  }
+  // The options of the selected command; nullptr for `help` or none.
+  const Args* selected_args() const {
+    for (const auto& a : args)
+      if (&a->app() == &selected()) return a.get();
+    return nullptr;
+  }
+  int run() const;
+};
+
+CommandLine::CommandLine() {
+  // Before the subcommands: they copy the formatter and the help flag.
+  auto fmt = std::make_shared<CLI::Formatter>();
+  fmt->label("Usage", "usage");
+  fmt->label("SUBCOMMAND", "COMMAND");
+  fmt->label("Positionals", "Arguments");
+  fmt->column_width(34);
+  app.formatter(fmt);
+  app.set_help_flag("-h,--help", "Print this help and exit");
+  app.require_subcommand(0, 1);
+  app.footer(
+      "Exit codes: 0 success, 2 bad input (one line naming what is wrong; nothing written), 1 internal error.\n"
+      "`cstab COMMAND --help` or `cstab help COMMAND`: a command's options. docs/cli.md: all of them.");
+  for (const auto& c : commands()) {
+    CLI::App* sub = app.add_subcommand(c.name, c.summary);
+    sub->group("Commands");
+    sub->footer(c.footer);  // also when empty: a subcommand starts with the top-level footer
+    args.push_back(std::make_unique<Args>(*sub));
+    c.declare(*args.back());
+  }
+  help = app.add_subcommand("help", "Print the help of cstab or of one COMMAND");
+  help->group("Commands");
+  help->add_option("COMMAND", help_topic, "the command (" + command_names() + ")")->type_name("");
+}
+
+int CommandLine::run() const {
+  if (help->parsed()) {
+    std::cout << (help_topic.empty() ? usage() : command_help(help_topic));
+    return 0;
+  }
+  for (size_t i = 0; i < commands().size(); ++i)
+    if (args[i]->app().parsed()) {
+      args[i]->check();
+      return commands()[i].run(*args[i]);
+    }
+  std::cout << usage();  // options but no command ("cstab --")
+  return 2;
+}
+
+bool ends_with(const std::string& s, const std::string& tail) {
+  return s.size() >= tail.size() && s.compare(s.size() - tail.size(), tail.size(), tail) == 0;
+}
+
+// "cstab merge [OPTIONS] OUT SHARD_DIR..."
+std::string usage_line(const CLI::App& command) {
+  CLI::Formatter fmt;
+  fmt.label("Usage", "usage");
+  const bool top = command.get_parent() == nullptr;
+  std::string line = fmt.make_usage(&command, top ? "cstab" : "cstab " + command.get_name());
+  while (!line.empty() && line.back() == '\n') line.pop_back();
+  return line;
+}
+
+// CLI11's error, as one line in our words where we have them.
+std::string parse_error_text(const CLI::ParseError& e, const CommandLine& cli) {
+  const CLI::App& cmd = cli.selected();
+  std::string what = e.what();
+  for (char& c : what)
+    if (c == '\n') c = ' ';
+  // Arguments the parser did not take come first: a misspelled option is
+  // the cause of the "required" error CLI11 would report before it.
+  std::vector<std::string> rest = cmd.remaining();
+  if (rest.empty()) rest = cli.app.remaining();
+  if (!rest.empty()) {
+    const std::string& first = rest.front();
+    const std::string see = cmd.get_parent() ? "cstab " + cmd.get_name() + " --help" : "cstab --help";
+    if (first.size() > 1 && first[0] == '-')
+      return first.substr(0, first.find('=')) + ": unknown option (`" + see + "` lists them)";
+    return "unexpected argument '" + first + "' (" + usage_line(cmd) + ")";
+  }
+  if (dynamic_cast<const CLI::RequiredError*>(&e) && ends_with(what, " is required")) {
+    const std::string name = what.substr(0, what.size() - std::string(" is required").size());
+    return name + ": required" + (name.rfind("-", 0) == 0 ? "" : " (" + usage_line(cmd) + ")");
+  }
+  if (ends_with(what, " was given a disallowed flag override"))
+    return "--" + what.substr(0, what.find(' ')) + ": takes no value";
+  if (what.rfind("-", 0) == 0 && ends_with(what, " missing") && what.find(" required ") != std::string::npos)
+    return what.substr(0, what.find(':')) + ": missing value";
+  return what;
+}
+
 }  // namespace
 
-int dispatch(const std::string& command, const std::vector<std::string>& args) {
-  if (command == "list") return cmd_list(args);
-  if (command == "run") return cmd_run(args);
-  if (command == "stability") return cmd_stability(args);
-  if (command == "matrix") return cmd_matrix(args);
-  if (command == "merge") return cmd_merge(args);
-  if (command == "report") return cmd_report(args);
-  if (command == "gate") return cmd_gate(args);
-  throw UsageError("unknown command '" + command + "' (known: list, run, stability, matrix, merge, report, gate)");
+void declare_case_options(Args& a) {
+  a.required("--problem", "P", "problem (`cstab list` lists them)")
+      .required("--method", "M", "stabilization method (`cstab list`)")
+      .value("--formulation", "F", "formulation of the problem (default: the method's own)")
+      .repeatable("--param", "NAME=VALUE", "method parameter (`cstab list`: each with its default)")
+      .required("--integrator", "I", "integrator (`cstab list`)")
+      .required("--t-end", "T", "end time: a number, `ref` (the problem's reference time) or `default` (its horizon)");
+}
+
+std::string usage() {
+  const CommandLine cli;
+  return cli.app.help();
+}
+
+std::string command_help(const std::string& command) {
+  if (!known_command(command))
+    throw UsageError("unknown command '" + command + "' (known: " + command_names() + ")");
+  const CommandLine cli;
+  return cli.app.get_subcommand(command)->help("cstab");
+}
+
+int main_command(const std::vector<std::string>& argv) {
+  if (argv.empty()) {
+    std::cout << usage();
+    return 2;
+  }
+  const bool named = argv[0].rfind("-", 0) != 0;
+  const std::string prefix = named ? "cstab " + argv[0] + ": error: " : "cstab: error: ";
+  try {
+    if (named && !known_command(argv[0]))
+      throw UsageError("unknown command '" + argv[0] + "' (known: " + command_names() + ")");
+    CommandLine cli;
+    try {
+      cli.app.parse(std::vector<std::string>(argv.rbegin(), argv.rend()));
+    } catch (const CLI::ParseError& e) {
+      if (e.get_exit_code() != 0) {
+        if (const Args* a = cli.selected_args()) a->check();
+        throw UsageError(parse_error_text(e, cli));
+      }
+      std::cout << cli.app.help();  // --help: the selected command's
+      return 0;
+    }
+    return cli.run();
+  } catch (const UsageError& e) {
+    std::cerr << prefix << e.what() << "\n";
+    return 2;
+  } catch (const std::exception& e) {
+    std::cerr << prefix << e.what() << "\n";
+    return 1;
+  }
 }
 
 }  // namespace cstab::cli

@@ -1,3 +1,6 @@
+// The cstab command line: one CLI11 subcommand per command, each declared
+// once (cli/*_command.cpp); the declarations parse the arguments and make
+// `cstab --help`, `cstab help [COMMAND]` and `cstab COMMAND --help`.
 #pragma once
 
 #include <string>
@@ -5,8 +8,21 @@
 
 namespace cstab::cli {
 
+class Args;
+
+// Parses `args` (argv without the program name), runs the command and
+// returns the exit code: 0 success, 2 bad input (one line on stderr naming
+// what is wrong, nothing written), 1 internal error; some commands add
+// their own (gate 1: a check failed; merge 3: cases missing).
+int main_command(const std::vector<std::string>& args);
+
+// `cstab --help`: the commands with a one-line description each.
 std::string usage();
-// Runs a subcommand; returns the exit code. Throws UsageError on bad input.
-int dispatch(const std::string& command, const std::vector<std::string>& args);
+// `cstab COMMAND --help`; throws UsageError for an unknown command.
+std::string command_help(const std::string& command);
+
+// The options `run` and `stability` share, spelled and described alike:
+// --problem, --method, --formulation, --param, --integrator, --t-end.
+void declare_case_options(Args& args);
 
 }  // namespace cstab::cli

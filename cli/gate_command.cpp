@@ -3,8 +3,9 @@
 //   only if every check passes, 1 if one fails, 2 for bad input.
 // cstab gate --update [--factor F] [--time-factor T] [--recovery-factor R] [--thresholds FILE] DIR
 //   re-baselines the bounds the file sets from DIR and prints what changed.
-// cstab gate --init FILE [--factor F] DIR
+// cstab gate --init FILE [--factor F] [--time-factor T] [--recovery-factor R] DIR
 //   writes a new thresholds file with every completed case of DIR.
+// (declare_gate below is what parses them and prints `cstab gate --help`.)
 #include "cli/gate_command.hpp"
 
 #include <filesystem>
@@ -24,18 +25,26 @@ const char* kDefaultThresholds = CSTAB_SOURCE_DIR "/matrices/gate-thresholds.csv
 
 }  // namespace
 
-int cmd_gate(const std::vector<std::string>& argv) {
-  Args args(argv, {"--thresholds", "--csv", "--factor", "--time-factor", "--recovery-factor", "--init"}, {"--update"});
-  if (args.positional().size() != 1)
-    throw UsageError(args.positional().empty() ? "expected the results folder DIR (usage: cstab gate [--thresholds FILE] DIR)"
-                                               : "expected one results folder, got " +
-                                                     std::to_string(args.positional().size()) + " arguments");
-  const std::string dir = args.positional()[0];
+void declare_gate(Args& a) {
+  const GateFactors d;
+  a.positional("DIR", "a matrix results folder (cstab matrix --out)", true)
+      .value("--thresholds", "FILE", "thresholds file (default: matrices/gate-thresholds.csv of the source tree)")
+      .value("--csv", "OUT", "also write the table of checks to OUT (CSV)")
+      .flag("--update", "re-baseline the bounds the thresholds file sets from DIR, print what changed")
+      .value("--init", "FILE", "write a new thresholds file FILE with every completed case of DIR")
+      .value("--factor", "F", "--update/--init: upper bounds = measured value x F (>= 1)", format_short(d.value))
+      .value("--time-factor", "T", "--update/--init: max_time_ratio = measured ratio x T", format_short(d.time_ratio))
+      .value("--recovery-factor", "R", "--update/--init: max_recovery_time = measured time x R",
+             format_short(d.recovery));
+}
+
+int cmd_gate(const Args& args) {
+  const std::string dir = args.require("DIR");
   if (!std::filesystem::is_directory(dir)) throw UsageError(dir + ": no such results folder");
   GateFactors factors;
-  factors.value = args.number("--factor", factors.value);
-  factors.time_ratio = args.number("--time-factor", factors.time_ratio);
-  factors.recovery = args.number("--recovery-factor", factors.recovery);
+  factors.value = args.number("--factor");
+  factors.time_ratio = args.number("--time-factor");
+  factors.recovery = args.number("--recovery-factor");
 
   if (args.has("--init")) {
     if (args.has("--update") || args.has("--thresholds") || args.has("--csv"))
@@ -53,7 +62,7 @@ int cmd_gate(const std::vector<std::string>& argv) {
     return 0;
   }
 
-  const std::string path = args.get("--thresholds", kDefaultThresholds);
+  const std::string path = args.has("--thresholds") ? args.get("--thresholds") : kDefaultThresholds;
   ThresholdsFile file = read_thresholds_file(path);
 
   if (args.has("--update")) {

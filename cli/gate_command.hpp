@@ -1,11 +1,11 @@
 // cstab gate: checks a matrix results folder against a thresholds file.
 #pragma once
 
-#include <string>
-#include <vector>
-
 namespace cstab::cli {
 
-int cmd_gate(const std::vector<std::string>& argv);
+class Args;
+
+void declare_gate(Args& args);
+int cmd_gate(const Args& args);
 
 }  // namespace cstab::cli

@@ -121,8 +121,12 @@ MatrixCatalog registry_catalog() {
 
 int default_jobs() { return std::max(1u, std::thread::hardware_concurrency()); }
 
+void declare_jobs(Args& args, const std::string& what) {
+  args.value("--jobs", "N", what + " at a time, in [1, 1024] (default: the number of cores)");
+}
+
 int jobs_flag(const Args& args) {
-  const long jobs = args.integer("--jobs", default_jobs());
+  const long jobs = args.has("--jobs") ? args.integer("--jobs") : default_jobs();
   if (jobs < 1 || jobs > 1024) throw UsageError("--jobs: must be in [1, 1024]");
   return int(jobs);
 }
@@ -136,6 +140,48 @@ void finish(const std::string& dir, int jobs, bool plots) {
             << " unchanged)\n";
 }
 
+// Outcomes over the whole folder, cached cases included: "3 ok, 1 diverged".
+std::string folder_outcomes(const std::string& out) {
+  std::map<std::string, size_t> outcomes;
+  const CsvTable summary = read_csv(out + "/summary.csv");
+  for (size_t r = 0; r < summary.rows.size(); ++r)
+    if (summary.get(r, "repeat") == "0") ++outcomes[summary.get(r, "status")];
+  std::string text;
+  for (const auto& [status, n] : outcomes)
+    text += (text.empty() ? "" : ", ") + std::to_string(n) + " " +
+            (status == "invalid" ? std::string("not applicable") : status);
+  return text.empty() ? "no results" : text;
+}
+
+std::string one_decimal(double v) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.1f", v);
+  return text;
+}
+
+// A run cut short: says so on stderr and returns the exit code; 0 if every
+// case finished.
+int unfinished_exit_code(const MatrixRunStats& stats, const std::string& out) {
+  if (stats.interrupted_by) {
+    // Finished cases are kept (and summarized); the report waits for a
+    // complete run.
+    std::cout.flush();
+    std::cerr << "cstab matrix: interrupted by " << stop_signal_name(stats.interrupted_by) << ": "
+              << stats.total - stats.unfinished << " of " << stats.total << " cases finished and kept in " << out
+              << "/summary.csv, " << stats.unfinished << " unfinished; run the same command again to resume (exit "
+              << 128 + stats.interrupted_by << ")\n";
+    return 128 + stats.interrupted_by;
+  }
+  if (stats.unfinished) {
+    std::cout.flush();
+    std::cerr << "cstab matrix: " << stats.unfinished << " of " << stats.total
+              << " cases unfinished (their workers were stopped by a signal); run the same command again to "
+                 "complete them (exit 1)\n";
+    return 1;
+  }
+  return 0;
+}
+
 }  // namespace
 
 const std::string& default_matrix_text() {
@@ -143,16 +189,25 @@ const std::string& default_matrix_text() {
   return text;
 }
 
-int cmd_matrix(const std::vector<std::string>& argv) {
-  Args args(argv, {"--out", "--jobs", "--shard", "--filter"}, {"--force", "--list", "--no-report", "--print-default"});
+void declare_matrix(Args& a) {
+  a.positional("FILE", "matrix file (docs/matrix.md); default: the embedded matrix (--print-default)", false)
+      .value("--out", "DIR", "results folder (created; cases already in it are reused)");
+  declare_jobs(a, "cases");
+  a.value("--shard", "K/N", "run only shard K of N (join the shard folders with `cstab merge`)")
+      .value("--filter", "S", "run only the cases whose label contains S, or whose id or sweep name is S (see --list)")
+      .flag("--force", "rerun cases even if their results are in DIR")
+      .flag("--no-report", "do not build the report after the run")
+      .flag("--list", "print the cases (index, id, sweep, label) and exit; no --out needed")
+      .flag("--print-default", "print the embedded default matrix and exit");
+}
+
+int cmd_matrix(const Args& args) {
   if (args.has("--print-default")) {
     std::cout << default_matrix_text();
     return 0;
   }
-  if (args.positional().size() > 1)
-    throw UsageError("one matrix file at most (got '" + args.positional()[1] + "' too)");
-  const bool from_file = !args.positional().empty();
-  const MatrixFile file = from_file ? read_matrix_file(args.positional()[0])
+  const bool from_file = args.has("FILE");
+  const MatrixFile file = from_file ? read_matrix_file(args.get("FILE"))
                                     : parse_matrix(default_matrix_text(), "<default matrix>");
   const Expansion expansion = expand_matrix(file, registry_catalog());
   int shard_k = 1, shard_n = 1;
@@ -206,37 +261,9 @@ int cmd_matrix(const std::vector<std::string>& argv) {
     for (const auto& c : cases) entries.push_back(c.entry);
     return entries;
   }());
-  // Outcomes over the whole folder, cached cases included.
-  std::map<std::string, size_t> outcomes;
-  const CsvTable summary = read_csv(out + "/summary.csv");
-  for (size_t r = 0; r < summary.rows.size(); ++r)
-    if (summary.get(r, "repeat") == "0") ++outcomes[summary.get(r, "status")];
-  std::string outcome_text;
-  for (const auto& [status, n] : outcomes)
-    outcome_text += (outcome_text.empty() ? "" : ", ") + std::to_string(n) + " " +
-                    (status == "invalid" ? std::string("not applicable") : status);
-  char secs[32];
-  std::snprintf(secs, sizeof secs, "%.1f", stats.seconds);
   std::cout << "matrix: " << stats.total << " cases: " << stats.run << " run, " << stats.cached << " cached, in "
-            << secs << " s; " << (outcome_text.empty() ? "no results" : outcome_text) << "; " << out
-            << "/summary.csv\n";
-  if (stats.interrupted_by) {
-    // Finished cases are kept (and summarized above); the report waits for
-    // a complete run.
-    std::cout.flush();
-    std::cerr << "cstab matrix: interrupted by " << stop_signal_name(stats.interrupted_by) << ": "
-              << stats.total - stats.unfinished << " of " << stats.total << " cases finished and kept in " << out
-              << "/summary.csv, " << stats.unfinished << " unfinished; run the same command again to resume (exit "
-              << 128 + stats.interrupted_by << ")\n";
-    return 128 + stats.interrupted_by;
-  }
-  if (stats.unfinished) {
-    std::cout.flush();
-    std::cerr << "cstab matrix: " << stats.unfinished << " of " << stats.total
-              << " cases unfinished (their workers were stopped by a signal); run the same command again to "
-                 "complete them (exit 1)\n";
-    return 1;
-  }
+            << one_decimal(stats.seconds) << " s; " << folder_outcomes(out) << "; " << out << "/summary.csv\n";
+  if (const int code = unfinished_exit_code(stats, out)) return code;
   if (shard_n > 1)
     std::cout << "matrix: shard " << shard_k << "/" << shard_n << " done; join the shards with `cstab merge OUT "
               << "SHARD_DIR...`\n";
@@ -245,14 +272,19 @@ int cmd_matrix(const std::vector<std::string>& argv) {
   return 0;
 }
 
-int cmd_merge(const std::vector<std::string>& argv) {
-  Args args(argv, {"--jobs"}, {"--no-report"});
-  const auto& pos = args.positional();
-  if (pos.size() < 2) throw UsageError("usage: cstab merge OUT SHARD_DIR... (at least one shard folder)");
-  const std::vector<std::string> shards(pos.begin() + 1, pos.end());
+void declare_merge(Args& a) {
+  a.positional("OUT", "folder for the merged results (created)", true)
+      .positional("SHARD_DIR", "results folders of `cstab matrix --shard K/N` (at least one)", true, true);
+  declare_jobs(a, "plots");
+  a.flag("--no-report", "do not build the report of OUT");
+}
+
+int cmd_merge(const Args& args) {
+  const std::string out = args.require("OUT");
+  const std::vector<std::string> shards = args.all("SHARD_DIR");
   const int jobs = jobs_flag(args);  // before anything is written
-  const size_t missing = merge_results(pos[0], shards, std::cout);
-  if (!args.has("--no-report")) finish(pos[0], jobs, true);
+  const size_t missing = merge_results(out, shards, std::cout);
+  if (!args.has("--no-report")) finish(out, jobs, true);
   if (missing) {
     std::cerr << "cstab merge: " << missing << " cases of the matrix are missing from the shards (exit code 3)\n";
     return 3;
@@ -260,10 +292,14 @@ int cmd_merge(const std::vector<std::string>& argv) {
   return 0;
 }
 
-int cmd_report(const std::vector<std::string>& argv) {
-  Args args(argv, {"--jobs"}, {"--no-plots"});
-  if (args.positional().size() != 1) throw UsageError("usage: cstab report DIR [--jobs N] [--no-plots]");
-  const std::string dir = args.positional()[0];
+void declare_report(Args& a) {
+  a.positional("DIR", "a matrix results folder (cstab matrix --out)", true);
+  declare_jobs(a, "plots");
+  a.flag("--no-plots", "tables and HTML only, no gnuplot");
+}
+
+int cmd_report(const Args& args) {
+  const std::string dir = args.require("DIR");
   const int jobs = jobs_flag(args);
   const std::vector<CaseEntry> entries = read_results_manifest(dir);
   write_matrix_summary(dir, entries);

@@ -2,13 +2,17 @@
 #pragma once
 
 #include <string>
-#include <vector>
 
 namespace cstab::cli {
 
-int cmd_matrix(const std::vector<std::string>& argv);
-int cmd_merge(const std::vector<std::string>& argv);
-int cmd_report(const std::vector<std::string>& argv);
+class Args;
+
+void declare_matrix(Args& args);
+int cmd_matrix(const Args& args);
+void declare_merge(Args& args);
+int cmd_merge(const Args& args);
+void declare_report(Args& args);
+int cmd_report(const Args& args);
 
 // The matrix `cstab matrix` runs without a FILE.
 const std::string& default_matrix_text();

@@ -1,6 +1,4 @@
-// cstab stability --problem P --method M --integrator I --gain-param NAME
-//                 --steps h1,h2,... --gains g1,g2,... --t-end T --out DIR
-//                 [--param k=v ...] [--formulation F] [--blowup B] [--bisect N]
+// cstab stability (declare_stability lists the options; --help prints them).
 // Writes DIR/stability.csv (the h x gain map), DIR/boundary.csv (per step:
 // the measured boundary in h*rate and the integrator's theoretical real
 // stability interval) and, if gnuplot is present, DIR/stability.png/.svg.
@@ -11,6 +9,7 @@
 #include <iostream>
 
 #include "cli/args.hpp"
+#include "cli/commands.hpp"
 #include "io/csv.hpp"
 #include "core/format.hpp"
 #include "harness/integrator.hpp"
@@ -19,43 +18,58 @@
 
 namespace cstab::cli {
 
-int cmd_stability(const std::vector<std::string>& argv) {
-  Args args(argv,
-            {"--problem", "--method", "--formulation", "--integrator", "--gain-param", "--steps", "--gains",
-             "--t-end", "--out", "--param", "--blowup", "--bisect"},
-            {"--no-plot"}, {"--param"});
-  if (!args.positional().empty()) throw UsageError("stability: unexpected argument '" + args.positional()[0] + "'");
+void declare_stability(Args& a) {
+  const StabilityConfig d;
+  declare_case_options(a);
+  a.required("--gain-param", "NAME", "the method parameter swept as the gain (lambda, alpha, dt, ...)")
+      .required("--steps", "H1,H2,...", "fixed steps of the map, each > 0")
+      .required("--gains", "G1,G2,...", "gains of the map, each > 0")
+      .value("--blowup", "B", "residual above which a run counts as unstable", "1")
+      .value("--bisect", "N", "bisection steps of the boundary search per step, in [0, 60]",
+             std::to_string(d.bisection_iterations))
+      .flag("--no-plot", "do not draw stability.png/.svg (gnuplot)")
+      .required("--out", "DIR", "output folder (created if missing)");
+}
+
+namespace {
+
+// Everything but the output folder, checked before any file is written.
+StabilityConfig read_stability(const Args& args, const Problem& problem) {
   StabilityConfig cfg;
   cfg.base.problem = args.require("--problem");
   cfg.base.method = args.require("--method");
   cfg.base.formulation = args.get("--formulation");
   cfg.base.integrator = args.require("--integrator");
-  const Problem& problem = find_problem(cfg.base.problem);
   if (!find_integrator(cfg.base.integrator).fixed_step)
     throw UsageError("--integrator " + cfg.base.integrator + ": stability maps need a fixed-step integrator");
   cfg.gain_param = args.require("--gain-param");
-  for (const auto& kv : args.all("--param")) {
-    const auto eq = kv.find('=');
-    if (eq == std::string::npos || eq == 0) throw UsageError("--param " + kv + ": expected name=value");
-    if (kv.substr(0, eq) == cfg.gain_param) throw UsageError("--param " + kv + ": that is the swept --gain-param");
-    cfg.base.params.emplace_back(kv.substr(0, eq), kv.substr(eq + 1));
+  for (const auto& [name, value] : args.pairs("--param")) {
+    if (name == cfg.gain_param)
+      throw UsageError("--param " + name + "=" + value + ": that is the swept --gain-param");
+    cfg.base.params.emplace_back(name, value);
   }
   cfg.steps = args.number_list("--steps");
   cfg.gains = args.number_list("--gains");
-  if (cfg.steps.empty()) throw UsageError("--steps: required (comma-separated)");
-  if (cfg.gains.empty()) throw UsageError("--gains: required (comma-separated)");
   for (double h : cfg.steps)
     if (!(h > 0)) throw UsageError("--steps: " + format_short(h) + " must be > 0");
   for (double g : cfg.gains)
     if (!(g > 0)) throw UsageError("--gains: " + format_short(g) + " must be > 0");
-  cfg.base.t_end = parse_finite_double(args.require("--t-end"), "--t-end");
+  cfg.base.t_end = args.end_time("--t-end", problem.info());
   if (!(cfg.base.t_end > 0)) throw UsageError("--t-end: must be > 0");
-  cfg.base.blowup = args.number("--blowup", 1.0);
+  cfg.base.blowup = args.number("--blowup");
   if (!(cfg.base.blowup > 0)) throw UsageError("--blowup: must be > 0");
-  const long bisect = args.integer("--bisect", 10);
+  const long bisect = args.integer("--bisect");
   // 60 halvings take any bracket below double resolution.
   if (bisect < 0 || bisect > 60) throw UsageError("--bisect: must be in [0, 60]");
   cfg.bisection_iterations = int(bisect);
+  return cfg;
+}
+
+}  // namespace
+
+int cmd_stability(const Args& args) {
+  const Problem& problem = find_problem(args.require("--problem"));
+  const StabilityConfig cfg = read_stability(args, problem);
   const std::string out = args.require("--out");
 
   // Validate the combination (method, gain parameter) with one cheap run

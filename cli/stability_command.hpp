@@ -1,11 +1,11 @@
 #pragma once
 
-#include <string>
-#include <vector>
-
 namespace cstab::cli {
 
+class Args;
+
 // cstab stability: step x gain maps and measured stability boundaries.
-int cmd_stability(const std::vector<std::string>& argv);
+void declare_stability(Args& args);
+int cmd_stability(const Args& args);
 
 }  // namespace cstab::cli

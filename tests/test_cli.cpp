@@ -3,6 +3,9 @@
 // writes summary.csv and series.csv with the documented columns.
 #include <gtest/gtest.h>
 
+#include "cli/args.hpp"
+#include "core/problem.hpp"
+#include "problems/registry.hpp"
 #include "tests/test_util.hpp"
 #include <sys/wait.h>
 #include <unistd.h>
@@ -12,7 +15,9 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <cctype>
 #include <map>
+#include <set>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -24,6 +29,8 @@ namespace {
 using cstab::testing::exit_code;
 using cstab::testing::quote;
 using cstab::testing::slurp;
+using cstab::find_problem;
+using cstab::Problem;
 
 // A scratch folder per test, removed afterwards.
 struct Scratch : cstab::testing::Scratch {
@@ -182,6 +189,29 @@ std::vector<BadCase> bad_cases() {
       {"sample_every_negative", with(kGood, "--sample-every", "-1"), "--sample-every"},
       {"switch_with_value", with(kGood, "--no-series=1", "x"), "--no-series"},
       {"positional_argument", [] { auto a = kGood; a.push_back("extra"); return a; }(), "extra"},
+      // the CLI11 parser: its errors in our words, naming the option
+      {"t_end_word", with(kGood, "--t-end", "reference"), "--t-end"},
+      {"t_end_ref_trailing", with(kGood, "--t-end", "ref "), "--t-end"},
+      {"value_missing_before_option", [] { auto a = kGood; a.push_back("--blowup"); return a; }(), "--blowup"},
+      {"value_missing_before_help", [] { auto a = kGood; a.insert(a.end(), {"--formulation", "--help"}); return a; }(),
+       "--formulation: missing value"},
+      {"inline_empty_value", [] { auto a = kGood; a.push_back("--blowup="); return a; }(), "--blowup: missing value"},
+      {"unknown_inline_option", [] { auto a = kGood; a.push_back("--no-such=3"); return a; }(),
+       "--no-such: unknown option"},
+      {"unknown_short_option", [] { auto a = kGood; a.push_back("-x"); return a; }(), "-x: unknown option"},
+      {"formulation_given_twice",
+       [] { auto a = kGood; a.insert(a.end(), {"--formulation", "state-space", "--formulation", "x"}); return a; }(),
+       "--formulation: given more than once"},
+      {"perturb_nan", with(kGood, "--perturb", "nan"), "--perturb"},
+      {"perturb_negative", with(kGood, "--perturb", "-1e-3"), "--perturb"},
+      {"recovery_threshold_garbage", with(kGood, "--recovery-threshold", "1e-10x"), "--recovery-threshold"},
+      {"recovery_threshold_zero", with(kGood, "--recovery-threshold", "0"), "--recovery-threshold"},
+      {"drift_fit_from_inf", with(kGood, "--drift-fit-from", "inf"), "--drift-fit-from"},
+      {"drift_fit_from_negative", with(kGood, "--drift-fit-from", "-1"), "--drift-fit-from"},
+      {"sample_every_nan", with(kGood, "--sample-every", "nan"), "--sample-every"},
+      {"observe_every_garbage", with(kGood, "--observe-every", "2x"), "--observe-every"},
+      {"blowup_trailing_garbage", with(kGood, "--blowup", "1e3 "), "--blowup"},
+      {"missing_t_end", without(kGood, "--t-end"), "--t-end: required"},
   };
 }
 
@@ -207,6 +237,13 @@ std::vector<OtherBadCase> other_bad_cases() {
       {"stability_bisect_negative", with(stab, "--bisect", "-1"), "--bisect"},
       {"stability_bisect_huge", with(stab, "--bisect", "100000000000"), "--bisect"},  // was a hang
       {"stability_t_end_nan", with(stab, "--t-end", "nan"), "--t-end"},
+      {"stability_t_end_word", with(stab, "--t-end", "reference"), "--t-end"},
+      {"stability_bisect_fraction", with(stab, "--bisect", "2.5"), "--bisect"},
+      {"stability_blowup_nan", with(stab, "--blowup", "nan"), "--blowup"},
+      {"stability_no_plot_with_value", [&] { auto a = stab; a.push_back("--no-plot=yes"); return a; }(),
+       "--no-plot: takes no value"},
+      {"stability_unknown_option", with(stab, "--step", "1e-3"), "--step: unknown option"},
+      {"stability_missing_out", without(stab, "--out"), "--out: required"},
       {"matrix_missing_file", {"matrix", "/nonexistent/m.toml", "--out", "{out}"}, "/nonexistent/m.toml"},
       {"matrix_folder_as_file", {"matrix", "/tmp", "--out", "{out}"}, "/tmp: is a folder"},
       {"matrix_jobs_zero", {"matrix", "--jobs", "0", "--out", "{out}"}, "--jobs"},
@@ -219,8 +256,21 @@ std::vector<OtherBadCase> other_bad_cases() {
       {"merge_jobs_zero", {"merge", "{out}", "{shard}", "--jobs", "0"}, "--jobs"},  // used to write first
       {"report_not_a_results_folder", {"report", "/tmp"}, "/tmp"},
       {"report_jobs_zero", {"report", "{shard}", "--jobs", "0"}, "--jobs"},
+      {"matrix_jobs_negative", {"matrix", "--jobs", "-2", "--out", "{out}"}, "--jobs"},
+      {"matrix_unknown_option", {"matrix", "--jbos", "2", "--out", "{out}"}, "--jbos: unknown option"},
+      {"matrix_out_missing_value", {"matrix", "--out"}, "--out: missing value"},
+      {"merge_no_report_with_value", {"merge", "{out}", "{shard}", "--no-report=1"}, "--no-report: takes no value"},
+      {"report_no_folder", {"report"}, "DIR: required"},
+      {"report_two_folders", {"report", "{shard}", "{shard}"}, "unexpected argument"},
+      {"gate_no_folder", {"gate"}, "DIR: required"},
+      {"gate_update_with_value", {"gate", "--update=yes", "{shard}"}, "--update: takes no value"},
+      {"gate_factor_garbage", {"gate", "--update", "--factor", "10x", "{shard}"}, "--factor"},
+      {"gate_time_factor_nan", {"gate", "--update", "--time-factor", "nan", "{shard}"}, "--time-factor"},
       {"list_extra_argument", {"list", "extra"}, "extra"},
+      {"list_unknown_option", {"list", "--all"}, "--all: unknown option"},
       {"unknown_command", {"frobnicate"}, "frobnicate"},
+      {"help_unknown_command", {"help", "frobnicate"}, "frobnicate"},
+      {"unknown_top_level_option", {"--verbose"}, "--verbose: unknown option"},
   };
 }
 
@@ -445,6 +495,201 @@ TEST(Cli, TimesDoNotDisturbTheTrajectory) {
     if (num(r[0]) == 0.2718) at = &r;
   ASSERT_NE(at, nullptr);
   for (size_t i = 0; i < kSeriesPrefix.size(); ++i) EXPECT_EQ((*at)[i], sc.rows.back()[i]) << sa.header[i];
+}
+
+// ---------------------------------------------------------------------------
+// --help, generated from the declarations that parse the options
+
+// What each command must offer (README, docs/cli.md, the scripts use them).
+const std::map<std::string, std::set<std::string>> kCommandOptions = {
+    {"list", {}},
+    {"run",
+     {"--problem", "--method", "--formulation", "--param", "--integrator", "--step", "--rtol", "--atol", "--t-end",
+      "--times", "--sample-every", "--ref-time", "--blowup", "--observe-every", "--perturb", "--recovery-threshold",
+      "--drift-fit-from", "--no-series", "--out"}},
+    {"stability",
+     {"--problem", "--method", "--formulation", "--param", "--integrator", "--gain-param", "--steps", "--gains",
+      "--t-end", "--blowup", "--bisect", "--no-plot", "--out"}},
+    {"matrix", {"--out", "--jobs", "--shard", "--filter", "--force", "--no-report", "--list", "--print-default"}},
+    {"merge", {"--jobs", "--no-report"}},
+    {"report", {"--jobs", "--no-plots"}},
+    {"gate", {"--thresholds", "--csv", "--update", "--init", "--factor", "--time-factor", "--recovery-factor"}},
+};
+
+// One option line of a --help: "  --step H      fixed step, for euler, rk4".
+struct HelpOption {
+  std::string name;
+  bool takes_value = false;  // a metavar follows the name
+  std::string description;
+};
+
+bool all_caps(const std::string& word) {
+  return std::none_of(word.begin(), word.end(), [](char c) { return std::islower(static_cast<unsigned char>(c)); });
+}
+
+std::vector<HelpOption> help_options(const std::string& help) {
+  std::vector<HelpOption> found;
+  std::istringstream lines(help);
+  std::string line;
+  while (std::getline(lines, line)) {
+    if (line.rfind("  -", 0) != 0) continue;
+    std::istringstream words(line);
+    std::string names, word;
+    words >> names;  // "-h,--help" or "--step"
+    HelpOption o;
+    o.name = names.substr(names.find(",--") == std::string::npos ? 0 : names.find(",--") + 1);
+    bool first = true;
+    while (words >> word) {
+      if (first && all_caps(word) && word != "REQUIRED") o.takes_value = true;
+      else if (!(o.description.empty() && word == "REQUIRED"))
+        o.description += (o.description.empty() ? "" : " ") + word;
+      first = false;
+    }
+    found.push_back(o);
+  }
+  return found;
+}
+
+TEST(CliHelp, EveryCommandListsExactlyItsOptionsWithADescriptionEach) {
+  Scratch s;
+  for (const auto& [command, expected] : kCommandOptions) {
+    SCOPED_TRACE(command);
+    const Outcome o = run_cli({command, "--help"}, s.dir());
+    EXPECT_EQ(o.code, 0) << o.err;
+    EXPECT_TRUE(o.err.empty()) << o.err;
+    EXPECT_NE(o.out.find("usage: cstab " + command), std::string::npos) << o.out;
+    EXPECT_EQ(o.out.find("`cstab COMMAND --help`"), std::string::npos) << "the top-level footer:\n" << o.out;
+    std::set<std::string> listed;
+    for (const auto& opt : help_options(o.out)) {
+      EXPECT_FALSE(opt.description.empty()) << opt.name << " has no description";
+      EXPECT_EQ(opt.description.find('\n'), std::string::npos);
+      if (opt.name != "--help") listed.insert(opt.name);
+    }
+    EXPECT_EQ(listed, expected);
+    EXPECT_EQ(run_cli({"help", command}, s.dir()).out, o.out) << "`cstab help " << command << "` differs";
+    EXPECT_EQ(run_cli({command, "-h"}, s.dir()).out, o.out);
+  }
+}
+
+// Every option the help lists is one the parser takes, as listed: with a
+// value (`--x=` is then "missing value") or without (`--x=v`: "takes no
+// value"); both fail while parsing, before the command runs.
+TEST(CliHelp, ListedOptionsParseAsListed) {
+  Scratch s;
+  for (const auto& [command, expected] : kCommandOptions) {
+    for (const auto& opt : help_options(run_cli({command, "--help"}, s.dir()).out)) {
+      if (opt.name == "--help") continue;
+      SCOPED_TRACE(command + " " + opt.name);
+      const Outcome o = run_cli({command, opt.name + (opt.takes_value ? "=" : "=v")}, s.dir());
+      EXPECT_EQ(o.code, 2) << o.out << o.err;
+      EXPECT_EQ(std::count(o.err.begin(), o.err.end(), '\n'), 1) << o.err;
+      EXPECT_NE(o.err.find("cstab " + command + ": error: " + opt.name +
+                           (opt.takes_value ? ": missing value" : ": takes no value")),
+                std::string::npos)
+          << o.err;
+    }
+    const Outcome unknown = run_cli({command, "--not-an-option"}, s.dir());
+    EXPECT_EQ(unknown.code, 2);
+    EXPECT_NE(unknown.err.find("--not-an-option: unknown option"), std::string::npos) << unknown.err;
+  }
+}
+
+TEST(CliHelp, TopLevelHelpListsEveryCommand) {
+  Scratch s;
+  const Outcome help = run_cli({"--help"}, s.dir());
+  EXPECT_EQ(help.code, 0) << help.err;
+  EXPECT_NE(help.out.find("usage: cstab"), std::string::npos) << help.out;
+  for (const auto& [command, options] : kCommandOptions) {
+    // "  run    Run one case; ..." in the Commands section.
+    const size_t at = help.out.find("\n  " + command + " ");
+    ASSERT_NE(at, std::string::npos) << command << " missing from\n" << help.out;
+    const std::string line = help.out.substr(at + 1, help.out.find('\n', at + 1) - at - 1);
+    EXPECT_NE(line.find_first_not_of(' ', 2 + command.size()), std::string::npos) << "no description: " << line;
+  }
+  EXPECT_EQ(run_cli({"help"}, s.dir()).out, help.out);
+  EXPECT_EQ(run_cli({"help"}, s.dir()).code, 0);
+  const Outcome help_help = run_cli({"help", "help"}, s.dir());
+  EXPECT_EQ(help_help.code, 0) << help_help.err;
+  EXPECT_NE(help_help.out.find("usage: cstab help [OPTIONS] [COMMAND]"), std::string::npos) << help_help.out;
+  EXPECT_EQ(run_cli({"-h"}, s.dir()).out, help.out);
+  const Outcome bare = run_cli({}, s.dir());  // no command: the same text, but exit 2
+  EXPECT_EQ(bare.code, 2);
+  EXPECT_EQ(bare.out, help.out);
+}
+
+// docs/cli.md documents every option of every command.
+TEST(CliHelp, DocsNameEveryOption) {
+  const std::string doc = slurp(fs::path(CSTAB_SOURCE_DIR) / "docs" / "cli.md");
+  ASSERT_FALSE(doc.empty());
+  for (const auto& [command, options] : kCommandOptions) {
+    const size_t section = doc.find("## cstab " + command);
+    ASSERT_NE(section, std::string::npos) << command;
+    const std::string text = doc.substr(section, doc.find("\n## ", section + 1) - section);
+    for (const auto& opt : options) EXPECT_NE(text.find(opt + " "), std::string::npos) << command << " " << opt;
+  }
+}
+
+// ---------------------------------------------------------------------------
+// --t-end ref / default, as matrix files read t_end = "ref" / "default"
+
+// "reference: ... (default at t = 5)" in `cstab list`, for `problem`.
+double listed_reference_time(const std::string& list, const std::string& problem) {
+  const size_t at = list.find("\n  " + problem + ": ");
+  if (at == std::string::npos) return std::nan("");
+  const size_t ref = list.find("    reference: ", at);
+  const size_t t = list.find("(default at t = ", ref);
+  if (ref == std::string::npos || t == std::string::npos || t > list.find('\n', ref)) return std::nan("");
+  return std::strtod(list.c_str() + t + std::string("(default at t = ").size(), nullptr);
+}
+
+Csv summary_of(const std::vector<std::string>& args, const fs::path& scratch, const fs::path& out) {
+  auto a = args;
+  a.insert(a.end(), {"--no-series", "--out", out.string()});
+  const Outcome o = run_cli(a, scratch);
+  EXPECT_EQ(o.code, 0) << o.err;
+  return read_csv(out / "summary.csv");
+}
+
+// The same words as matrix files: "ref" falls back to the default horizon
+// for a problem without a reference (none of the registered ones today).
+TEST(Args, EndTimeWordsAndNumbers) {
+  cstab::ProblemInfo with_ref, without_ref;
+  with_ref.reference_time = 3;
+  with_ref.default_t_end = 20;
+  without_ref.default_t_end = 7;
+  using cstab::cli::resolve_end_time;
+  EXPECT_EQ(resolve_end_time("ref", with_ref, "--t-end"), 3);
+  EXPECT_EQ(resolve_end_time("default", with_ref, "--t-end"), 20);
+  EXPECT_EQ(resolve_end_time("ref", without_ref, "--t-end"), 7);
+  EXPECT_EQ(resolve_end_time("default", without_ref, "--t-end"), 7);
+  EXPECT_EQ(resolve_end_time("0.25", with_ref, "--t-end"), 0.25);
+  for (const char* bad : {"REF", "reference", "ref ", "", "nan", "inf", "2s"}) {
+    try {
+      resolve_end_time(bad, with_ref, "--t-end");
+      ADD_FAILURE() << "accepted '" << bad << "'";
+    } catch (const cstab::UsageError& e) {
+      EXPECT_EQ(std::string(e.what()).rfind("--t-end: ", 0), 0u) << e.what();
+    }
+  }
+}
+
+TEST(Cli, TEndRefIsTheProblemsReferenceTime) {
+  Scratch s;
+  const Problem& wheel = find_problem("wheel");
+  const double ref = listed_reference_time(run_cli({"list"}, s.dir()).out, "wheel");
+  ASSERT_GT(ref, 0) << "cstab list shows no reference time for wheel";
+  EXPECT_EQ(ref, wheel.info().reference_time);
+  const auto base = with(kGood, "--t-end", "ref");
+  const Csv sum = summary_of(base, s.dir(), s.dir() / "ref");
+  ASSERT_EQ(sum.rows.size(), 1u);
+  EXPECT_EQ(num(sum.rows[0][size_t(sum.col("t_end"))]), ref);
+  EXPECT_EQ(num(sum.rows[0][size_t(sum.col("t_reached"))]), ref);
+  EXPECT_EQ(num(sum.rows[0][size_t(sum.col("ref_time"))]), ref);
+  EXPECT_FALSE(std::isnan(num(sum.rows[0][size_t(sum.col("ref_error"))])));
+
+  const Csv def = summary_of(with(base, "--t-end", "default"), s.dir(), s.dir() / "default");
+  ASSERT_EQ(def.rows.size(), 1u);
+  EXPECT_EQ(num(def.rows[0][size_t(def.col("t_end"))]), wheel.info().default_t_end);
 }
 
 // The series is a time series: strictly increasing t, one row per time.
