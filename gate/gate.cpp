@@ -236,17 +236,16 @@ std::string ThresholdRow::label() const {
   return s;
 }
 
-ThresholdsFile parse_thresholds(const std::string& text, const std::string& file_name) {
-  ThresholdsFile file;
-  file.name = file_name;
-  file.lines = split_lines(text);
+namespace {
+
+// The header line: its column names and 0-based positions, checked here so errors name columns.
+std::map<std::string, int> parse_header(ThresholdsFile& file, const std::string& text) {
+  const std::string& file_name = file.name;
   if (text.find('\0') != std::string::npos) {
     int line = 1;
     for (char c : text.substr(0, text.find('\0'))) line += c == '\n';
     throw UsageError(where(file_name, line, 0) + ": NUL byte: not a text file");
   }
-
-  // The header: its names and positions, checked here so errors name columns.
   int header_line = 0;
   for (size_t i = 0; i < file.lines.size(); ++i)
     if (!is_comment_line(file.lines[i])) {
@@ -267,10 +266,76 @@ ThresholdsFile parse_thresholds(const std::string& text, const std::string& file
   }
   for (const auto& c : kRequired)
     if (!position.count(c)) throw UsageError(where(file_name, header_line, 0) + ": missing required column '" + c + "'");
+  return position;
+}
 
-  // The rows, tokenized by fast-cpp-csv-parser (quoting, trimming, comments).
+// The key a row names a case by, for duplicate detection: settings and parameters in canonical form.
+std::string case_key(const ThresholdRow& row) {
+  return row.problem + " " + row.method + " " + row.integrator + " " + canonical_key_values(row.setting) + " (" +
+         row.formulation + ") " + row.sweep + " [" + canonical_key_values(row.params) + "] " +
+         (std::isnan(row.t_end) ? "" : format_short(row.t_end));
+}
+
+// One data row from its cells (by known column; nullptr: not in the file).
+ThresholdRow parse_row(const ThresholdsFile& file, std::map<std::string, int>& position, int line,
+                       char* const* cells) {
+  ThresholdRow row;
+  row.line = line;
+  row.fields.assign(file.columns.size(), "");
+  std::map<std::string, std::string> value;
+  for (unsigned k = 0; k < kColumnCount; ++k) {
+    if (!cells[k]) continue;
+    value[kColumns[k]] = cells[k];
+    row.fields[position[kColumns[k]]] = cells[k];
+  }
+  auto at = [&](const std::string& column) { return where(file.name, row.line, position[column] + 1); };
+  auto text_of = [&](const std::string& column) {
+    auto it = value.find(column);
+    return it == value.end() ? std::string() : it->second;
+  };
+  for (const auto& c : kRequired)
+    if (text_of(c).empty()) throw UsageError(at(c) + ": " + c + ": required, empty");
+  row.name = text_of("name");
+  row.sweep = text_of("sweep");
+  row.problem = text_of("problem");
+  row.method = text_of("method");
+  row.formulation = text_of("formulation");
+  row.integrator = text_of("integrator");
+  row.params = text_of("params");
+  row.setting = text_of("setting");
+  row.baseline = text_of("baseline");
+  if (!text_of("t_end").empty()) {
+    row.t_end = number_or_throw(text_of("t_end"), at("t_end"), "t_end");
+    if (!(row.t_end > 0)) throw UsageError(at("t_end") + ": t_end: must be > 0");
+  }
+  if (!text_of("status").empty()) {
+    const auto status = parse_status(text_of("status"));
+    if (!status || !is_gateable(*status))
+      throw UsageError(at("status") + ": status: '" + text_of("status") + "' is not one of ok, diverged, failed");
+    row.status = *status;
+  }
+  for (const auto& b : kBounds) {
+    const std::string s = text_of(b.column);
+    if (s.empty()) continue;
+    const double v = number_or_throw(s, at(b.column), b.column);
+    if (v < 0) throw UsageError(at(b.column) + ": " + b.column + ": " + s + " is negative (bounds are >= 0)");
+    if (std::string(b.column) == "max_time_ratio" && v == 0)
+      throw UsageError(at(b.column) + ": max_time_ratio: must be > 0");
+    row.*(b.bound) = v;
+  }
+  if (!std::isnan(row.max_time_ratio) && row.baseline.empty())
+    throw UsageError(at("max_time_ratio") + ": max_time_ratio needs a baseline (the name of another row)");
+  if (std::isnan(row.max_time_ratio) && !row.baseline.empty())
+    throw UsageError(at("baseline") + ": baseline given without max_time_ratio");
+  return row;
+}
+
+// The rows, tokenized by fast-cpp-csv-parser (quoting, trimming, comments); no duplicate case or name.
+void parse_rows(ThresholdsFile& file, const std::string& text, std::map<std::string, int>& position,
+                std::map<std::string, int>& name_line) {
+  const std::string& file_name = file.name;
   Reader reader(file_name, text.data(), text.data() + text.size());
-  std::map<std::string, int> key_line, name_line;
+  std::map<std::string, int> key_line;
   try {
     reader.read_header(io::ignore_missing_column, "name", "sweep", "problem", "method", "formulation", "integrator",
                        "params", "setting", "t_end", "status", "max_residual", "max_final_residual",
@@ -283,65 +348,16 @@ ThresholdsFile parse_thresholds(const std::string& text, const std::string& file
                            cells[9], cells[10], cells[11], cells[12], cells[13], cells[14], cells[15], cells[16],
                            cells[17], cells[18], cells[19]))
         break;
-      ThresholdRow row;
-      row.line = int(reader.get_file_line());
-      row.fields.assign(file.columns.size(), "");
-      std::map<std::string, std::string> value;
-      for (unsigned k = 0; k < kColumnCount; ++k) {
-        if (!cells[k]) continue;
-        value[kColumns[k]] = cells[k];
-        row.fields[position[kColumns[k]]] = cells[k];
-      }
-      auto at = [&](const std::string& column) { return where(file_name, row.line, position[column] + 1); };
-      auto text_of = [&](const std::string& column) {
-        auto it = value.find(column);
-        return it == value.end() ? std::string() : it->second;
-      };
-      for (const auto& c : kRequired)
-        if (text_of(c).empty()) throw UsageError(at(c) + ": " + c + ": required, empty");
-      row.name = text_of("name");
-      row.sweep = text_of("sweep");
-      row.problem = text_of("problem");
-      row.method = text_of("method");
-      row.formulation = text_of("formulation");
-      row.integrator = text_of("integrator");
-      row.params = text_of("params");
-      row.setting = text_of("setting");
-      row.baseline = text_of("baseline");
-      if (!text_of("t_end").empty()) {
-        row.t_end = number_or_throw(text_of("t_end"), at("t_end"), "t_end");
-        if (!(row.t_end > 0)) throw UsageError(at("t_end") + ": t_end: must be > 0");
-      }
-      if (!text_of("status").empty()) {
-        const auto status = parse_status(text_of("status"));
-        if (!status || !is_gateable(*status))
-          throw UsageError(at("status") + ": status: '" + text_of("status") + "' is not one of ok, diverged, failed");
-        row.status = *status;
-      }
-      for (const auto& b : kBounds) {
-        const std::string s = text_of(b.column);
-        if (s.empty()) continue;
-        const double v = number_or_throw(s, at(b.column), b.column);
-        if (v < 0) throw UsageError(at(b.column) + ": " + b.column + ": " + s + " is negative (bounds are >= 0)");
-        if (std::string(b.column) == "max_time_ratio" && v == 0)
-          throw UsageError(at(b.column) + ": max_time_ratio: must be > 0");
-        row.*(b.bound) = v;
-      }
-      if (!std::isnan(row.max_time_ratio) && row.baseline.empty())
-        throw UsageError(at("max_time_ratio") + ": max_time_ratio needs a baseline (the name of another row)");
-      if (std::isnan(row.max_time_ratio) && !row.baseline.empty())
-        throw UsageError(at("baseline") + ": baseline given without max_time_ratio");
-      const std::string key = row.problem + " " + row.method + " " + row.integrator + " " +
-                              canonical_key_values(row.setting) + " (" + row.formulation + ") " + row.sweep + " [" +
-                              canonical_key_values(row.params) + "] " + (std::isnan(row.t_end) ? "" : format_short(row.t_end));
+      ThresholdRow row = parse_row(file, position, int(reader.get_file_line()), cells);
+      const std::string key = case_key(row);
       if (key_line.count(key))
         throw UsageError(where(file_name, row.line, 0) + ": duplicate case " + row.label() + " (first at line " +
                          std::to_string(key_line[key]) + ")");
       key_line[key] = row.line;
       if (!row.name.empty()) {
         if (name_line.count(row.name))
-          throw UsageError(at("name") + ": duplicate name '" + row.name + "' (first at line " +
-                           std::to_string(name_line[row.name]) + ")");
+          throw UsageError(where(file_name, row.line, position["name"] + 1) + ": duplicate name '" + row.name +
+                           "' (first at line " + std::to_string(name_line[row.name]) + ")");
         name_line[row.name] = row.line;
       }
       file.rows.push_back(std::move(row));
@@ -357,14 +373,34 @@ ThresholdsFile parse_thresholds(const std::string& text, const std::string& file
   } catch (const io::error::base& e) {
     throw UsageError(file_name + ": " + e.what());
   }
+}
+
+// Every baseline names another row.
+void check_baselines(const ThresholdsFile& file, std::map<std::string, int>& position,
+                     const std::map<std::string, int>& name_line) {
   for (const auto& row : file.rows) {
     if (row.baseline.empty()) continue;
     if (!name_line.count(row.baseline))
-      throw UsageError(where(file_name, row.line, position["baseline"] + 1) + ": baseline '" + row.baseline +
+      throw UsageError(where(file.name, row.line, position["baseline"] + 1) + ": baseline '" + row.baseline +
                        "' is not the name of any row");
     if (row.baseline == row.name)
-      throw UsageError(where(file_name, row.line, position["baseline"] + 1) + ": a row cannot be its own baseline");
+      throw UsageError(where(file.name, row.line, position["baseline"] + 1) + ": a row cannot be its own baseline");
   }
+}
+
+}  // namespace
+
+ThresholdsFile parse_thresholds(const std::string& text, const std::string& file_name) {
+  ThresholdsFile file;
+  file.name = file_name;
+  file.lines = split_lines(text);
+  // The header: names and positions.
+  std::map<std::string, int> position = parse_header(file, text);
+  // The rows.
+  std::map<std::string, int> name_line;
+  parse_rows(file, text, position, name_line);
+  // Cross-row checks.
+  check_baselines(file, position, name_line);
   return file;
 }
 

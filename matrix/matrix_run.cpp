@@ -593,64 +593,63 @@ size_t write_matrix_summary(const std::string& dir, const std::vector<CaseEntry>
   return missing;
 }
 
-size_t merge_results(const std::string& out_dir, const std::vector<std::string>& shard_dirs, std::ostream& log) {
-  if (shard_dirs.empty()) throw UsageError("give at least one shard folder");
+namespace {
+
+// What the shard folders of a merge hold together.
+struct Shards {
   std::string matrix_text;
   std::map<size_t, std::pair<CaseEntry, std::string>> by_index;  // index -> entry, source folder
   size_t selected_cases = 0;
   std::set<std::string> binaries;
-  Provenance merged;
-  for (size_t s = 0; s < shard_dirs.size(); ++s) {
-    const std::string& dir = shard_dirs[s];
-    std::error_code same_ec;
-    if (fs::equivalent(dir, out_dir, same_ec))
-      throw UsageError("the output folder " + out_dir + " is also a shard folder");
-    std::string text;
-    try {
-      text = read_text_file(dir + "/matrix.toml");
-    } catch (const std::exception&) {
-      throw UsageError(dir + " is not a matrix results folder (no matrix.toml)");
-    }
-    if (s == 0)
-      matrix_text = text;
-    else if (text != matrix_text)
-      throw UsageError(dir + " ran a different matrix than " + shard_dirs[0] +
-                       " (matrix.toml differs)");
-    size_t n = 0;
-    std::vector<CaseEntry> entries;
-    try {
-      entries = read_manifest(dir + "/cases.csv", &n);
-    } catch (const std::runtime_error& e) {
-      throw UsageError(dir + ": " + e.what());
-    }
-    if (n) selected_cases = n;
-    for (auto& e : entries) {
-      auto [it, inserted] = by_index.emplace(e.index, std::make_pair(e, dir));
-      if (!inserted && it->second.first.id != e.id)
-        throw UsageError("case " + std::to_string(e.index) + " differs between " + it->second.second +
-                         " and " + dir);
-    }
-    try {
-      for (auto [k, v] : parse_provenance(read_text_file(dir + "/provenance.txt"))) {
-        if (k == "binary_identity") binaries.insert(v);
-        merged.emplace_back("shard" + std::to_string(s + 1) + "." + k, v);
-      }
-    } catch (const std::exception&) {
-    }
-  }
-  if (binaries.size() > 1)
-    log << "merge: warning: the shards were run by " << binaries.size() << " different binaries\n";
+  Provenance provenance;  // every shard's, keys prefixed "shard<k>."
+};
 
-  std::error_code ec;
-  fs::create_directories(out_dir + "/cases", ec);
-  if (ec) throw UsageError("cannot create " + out_dir + ": " + ec.message());
+// Adds shard `s` (folder `dir`): same matrix as the first, consistent case ids.
+void read_shard(Shards& shards, const std::string& out_dir, const std::vector<std::string>& shard_dirs, size_t s) {
+  const std::string& dir = shard_dirs[s];
+  std::error_code same_ec;
+  if (fs::equivalent(dir, out_dir, same_ec)) throw UsageError("the output folder " + out_dir + " is also a shard folder");
+  std::string text;
+  try {
+    text = read_text_file(dir + "/matrix.toml");
+  } catch (const std::exception&) {
+    throw UsageError(dir + " is not a matrix results folder (no matrix.toml)");
+  }
+  if (s == 0)
+    shards.matrix_text = text;
+  else if (text != shards.matrix_text)
+    throw UsageError(dir + " ran a different matrix than " + shard_dirs[0] + " (matrix.toml differs)");
+  size_t n = 0;
   std::vector<CaseEntry> entries;
+  try {
+    entries = read_manifest(dir + "/cases.csv", &n);
+  } catch (const std::runtime_error& e) {
+    throw UsageError(dir + ": " + e.what());
+  }
+  if (n) shards.selected_cases = n;
+  for (auto& e : entries) {
+    auto [it, inserted] = shards.by_index.emplace(e.index, std::make_pair(e, dir));
+    if (!inserted && it->second.first.id != e.id)
+      throw UsageError("case " + std::to_string(e.index) + " differs between " + it->second.second + " and " + dir);
+  }
+  try {
+    for (auto [k, v] : parse_provenance(read_text_file(dir + "/provenance.txt"))) {
+      if (k == "binary_identity") shards.binaries.insert(v);
+      shards.provenance.emplace_back("shard" + std::to_string(s + 1) + "." + k, v);
+    }
+  } catch (const std::exception&) {
+  }
+}
+
+// Copies every complete case folder not already in out_dir (key.txt last); returns how many.
+size_t copy_complete_cases(const std::string& out_dir, const Shards& shards, std::vector<CaseEntry>& entries) {
+  std::error_code ec;
   size_t copied = 0;
-  for (const auto& [index, entry_source] : by_index) {
+  for (const auto& [index, entry_source] : shards.by_index) {
     const auto& [e, source] = entry_source;
     entries.push_back(e);
+    if (!load_case_result(source, e).complete) continue;  // counted by write_matrix_summary
     const std::string from = case_folder(source, e.id), to = case_folder(out_dir, e.id);
-    if (!fs::exists(from + "/key.txt")) continue;  // counted by write_matrix_summary
     const std::string key = read_text_file(from + "/key.txt");
     if (file_equals(to + "/key.txt", key)) continue;
     fs::create_directories(to, ec);
@@ -662,14 +661,33 @@ size_t merge_results(const std::string& out_dir, const std::vector<std::string>&
     write_file_atomic(to + "/key.txt", key);
     ++copied;
   }
-  write_file_atomic(out_dir + "/matrix.toml", matrix_text);
-  write_manifest(out_dir + "/cases.csv", entries, selected_cases);
+  return copied;
+}
+
+}  // namespace
+
+size_t merge_results(const std::string& out_dir, const std::vector<std::string>& shard_dirs, std::ostream& log) {
+  if (shard_dirs.empty()) throw UsageError("give at least one shard folder");
+  // Read and check every shard.
+  Shards shards;
+  for (size_t s = 0; s < shard_dirs.size(); ++s) read_shard(shards, out_dir, shard_dirs, s);
+  if (shards.binaries.size() > 1)
+    log << "merge: warning: the shards were run by " << shards.binaries.size() << " different binaries\n";
+  // Copy the complete cases.
+  std::error_code ec;
+  fs::create_directories(out_dir + "/cases", ec);
+  if (ec) throw UsageError("cannot create " + out_dir + ": " + ec.message());
+  std::vector<CaseEntry> entries;
+  const size_t copied = copy_complete_cases(out_dir, shards, entries);
+  // The union manifest, the matrix, provenance of every shard, summary.csv.
+  write_file_atomic(out_dir + "/matrix.toml", shards.matrix_text);
+  write_manifest(out_dir + "/cases.csv", entries, shards.selected_cases);
   Provenance own = collect_provenance();
   own.emplace_back("merged_from", std::to_string(shard_dirs.size()) + " shard folders");
-  own.insert(own.end(), merged.begin(), merged.end());
+  own.insert(own.end(), shards.provenance.begin(), shards.provenance.end());
   write_file_atomic(out_dir + "/provenance.txt", format_provenance(own));
   const size_t missing_results = write_matrix_summary(out_dir, entries);
-  const size_t uncovered = selected_cases > entries.size() ? selected_cases - entries.size() : 0;
+  const size_t uncovered = shards.selected_cases > entries.size() ? shards.selected_cases - entries.size() : 0;
   log << "merge: " << entries.size() << " cases from " << shard_dirs.size() << " folders (" << copied
       << " copied) into " << out_dir << "\n";
   if (missing_results) log << "merge: warning: " << missing_results << " cases have no complete result\n";
