@@ -20,6 +20,7 @@
 
 #include "core/format.hpp"
 #include "io/csv.hpp"
+#include "io/number.hpp"
 #include "matrix/matrix.hpp"
 #include "matrix/provenance.hpp"
 #include "matrix/results.hpp"
@@ -547,8 +548,17 @@ std::vector<CaseEntry> read_manifest(const std::string& path, size_t* selected_c
   std::vector<CaseEntry> out;
   if (selected_cases) *selected_cases = 0;
   for (size_t i = 0; i < t.rows.size(); ++i) {
+    // A number cell (io/number.hpp); `whole`: a non-negative integer.
+    auto number = [&](const char* col, bool whole) {
+      double v = 0;
+      const std::string& text = t.get(i, col);
+      if (!try_parse_number(text, v) || !std::isfinite(v) || (whole && (v < 0 || v != std::floor(v))))
+        throw UsageError(path + ": row " + std::to_string(i + 2) + ": " + col + ": '" + text + "' is not " +
+                         (whole ? "a count" : "a number"));
+      return v;
+    };
     CaseEntry e;
-    e.index = std::stoul(t.get(i, "index"));
+    e.index = size_t(number("index", true));
     e.id = t.get(i, "case_id");
     e.sweep = t.get(i, "sweep");
     e.problem = t.get(i, "problem");
@@ -557,12 +567,12 @@ std::vector<CaseEntry> read_manifest(const std::string& path, size_t* selected_c
     e.integrator = t.get(i, "integrator");
     e.params = t.get(i, "params");
     e.setting = t.get(i, "setting");
-    e.t_end = std::stod(t.get(i, "t_end"));
-    e.repeats = std::stoi(t.get(i, "repeats"));
+    e.t_end = number("t_end", false);
+    e.repeats = int(number("repeats", true));
     e.work_precision = t.get(i, "work_precision") == "1";
     e.overlay = t.get(i, "overlay") == "1";
     e.curve = t.get(i, "curve");
-    if (selected_cases && !t.get(i, "selected_cases").empty()) *selected_cases = std::stoul(t.get(i, "selected_cases"));
+    if (selected_cases && !t.get(i, "selected_cases").empty()) *selected_cases = size_t(number("selected_cases", true));
     out.push_back(std::move(e));
   }
   return out;

@@ -219,6 +219,33 @@ TEST(GateThresholds, ResultsModelFoldsRepeats) {
   EXPECT_EQ(t.get(3, "status"), "timeout");
 }
 
+// A manifest with a cell that is not a number is not a results folder (a
+// UsageError naming the file, row and column), for the gate and the report alike.
+TEST(GateThresholds, ManifestNumbersAreChecked) {
+  Scratch s("cstab_manifest");
+  const std::string dir = s.dir().string();
+  const std::string head = "index,case_id,sweep,problem,method,formulation,integrator,params,setting,t_end,repeats,"
+                           "work_precision,overlay,curve,selected_cases\n";
+  write(dir + "/cases.csv", head + "0,0000000000000000,a,wheel,baumgarte,,rk4,,step=0.001,1e-1,3,1,0,c,1\n");
+  const auto entries = cstab::read_results_manifest(dir);
+  ASSERT_EQ(entries.size(), 1u);
+  EXPECT_EQ(entries[0].t_end, 0.1);
+  EXPECT_EQ(entries[0].repeats, 3);
+  for (const auto& [row, what] : std::vector<std::pair<std::string, std::string>>{
+           {"0,0000000000000000,a,wheel,baumgarte,,rk4,,step=0.001,soon,3,1,0,c,1", "t_end: 'soon' is not a number"},
+           {"0,0000000000000000,a,wheel,baumgarte,,rk4,,step=0.001,1,2.5,1,0,c,1", "repeats: '2.5' is not a count"},
+           {"x,0000000000000000,a,wheel,baumgarte,,rk4,,step=0.001,1,3,1,0,c,1", "index: 'x' is not a count"}}) {
+    write(dir + "/cases.csv", head + row + "\n");
+    try {
+      cstab::read_results_manifest(dir);
+      ADD_FAILURE() << row;
+    } catch (const UsageError& e) {
+      EXPECT_NE(std::string(e.what()).find("not a matrix results folder"), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find("cases.csv: row 2: " + what), std::string::npos) << e.what();
+    }
+  }
+}
+
 // ------------------------------------------------- gate on a small matrix
 
 // Two wheel cases, run once per test suite.
