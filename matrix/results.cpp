@@ -216,6 +216,14 @@ ResultsFolder load_results_folder(const std::string& dir) {
   return f;
 }
 
+CsvTable load_case_series(const std::string& dir, const CaseEntry& entry) {
+  try {
+    return read_csv(dir + "/cases/" + entry.id + "/series.csv");
+  } catch (const std::exception&) {
+    return {};
+  }
+}
+
 std::string canonical_key_values(const std::string& text) {
   std::map<std::string, std::string> items;
   size_t at = 0;

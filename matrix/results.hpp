@@ -111,6 +111,10 @@ ResultsFolder load_results_folder(const std::string& dir);
 // The result of one case of `dir` (complete or not).
 CaseResult load_case_result(const std::string& dir, const CaseEntry& entry);
 
+// cases/<id>/series.csv of a case; empty (no header, no rows) if it is
+// missing or unreadable.
+CsvTable load_case_series(const std::string& dir, const CaseEntry& entry);
+
 // Configuration keys ("step=0.001;perturb=1e-3", "a=1;b=2") compared by
 // meaning: the same keys, each value equal as a number if both are
 // numbers ("1e-3" == "0.001"), else as text; order does not matter.

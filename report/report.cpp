@@ -241,13 +241,7 @@ double cell(const std::vector<std::string>& row, int col) {
 }
 
 // A case's series.csv; empty if it is missing or unreadable.
-CsvTable read_series(const std::string& dir, const CaseResult& c) {
-  try {
-    return read_csv(dir + "/cases/" + c.entry->id + "/series.csv");
-  } catch (const std::exception&) {
-    return {};
-  }
-}
+CsvTable read_series(const std::string& dir, const CaseResult& c) { return load_case_series(dir, *c.entry); }
 
 // Overlay data: per run, t, max |residual|, |drift|. Colours in `lcs`.
 std::string overlay_data(const std::string& dir, const std::vector<const CaseResult*>& runs,

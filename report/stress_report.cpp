@@ -204,12 +204,7 @@ struct LongPlots {
 // The running max |E - E0| of a finished case from its series (decimated rows).
 void add_long_series(LongPlots& plots, const std::string& dir, const CaseResult& c) {
   if (c.status != Status::kOk) return;
-  CsvTable series;
-  try {
-    series = read_csv(dir + "/cases/" + c.entry->id + "/series.csv");
-  } catch (const std::exception&) {
-    return;
-  }
+  const CsvTable series = load_case_series(dir, *c.entry);
   if (series.column("t") < 0 || series.column("energy_drift") < 0) return;
   const std::string& sweep = c.entry->sweep;
   add_once(plots.sweeps, sweep);
