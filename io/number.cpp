@@ -10,6 +10,10 @@ namespace cstab {
 
 std::string number_cell(double v) { return std::isnan(v) ? std::string() : format_exact(v); }
 
+std::string count_cell(long n) { return n < 0 ? std::string() : std::to_string(n); }
+
+std::string log_plot_cell(double v) { return std::isfinite(v) && v > 0 ? format_exact(v) : "?"; }
+
 bool try_parse_number(const std::string& text, double& value) {
   const char* begin = text.c_str();
   while (*begin == ' ' || *begin == '\t') ++begin;

@@ -10,6 +10,13 @@ namespace cstab {
 // exact (format_exact).
 std::string number_cell(double v);
 
+// A count cell: "" for a negative count (not recorded), else the integer.
+std::string count_cell(long n);
+
+// A value in a gnuplot data file for a log-scale axis: round-trip exact if
+// finite and > 0, else "?" (gnuplot's missing value).
+std::string log_plot_cell(double v);
+
 // The number a whole cell holds ("1e-3", "0.001", "inf", "nan"); NaN if the
 // cell is empty or is not entirely a number (leading/trailing blanks aside).
 double parse_number(const std::string& text);

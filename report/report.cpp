@@ -79,12 +79,6 @@ std::string base64(const std::string& data) {
   return out;
 }
 
-// A count cell: "" if not recorded.
-std::string count_cell(long n) { return n < 0 ? std::string() : std::to_string(n); }
-
-// A value for a log-scale plot column: "?" (missing) unless finite and > 0.
-std::string log_cell(double v) { return std::isfinite(v) && v > 0 ? format_exact(v) : "?"; }
-
 // A finished case with a timing: a point of the work-precision pictures and tables.
 bool timed(const CaseResult& c) { return c.ok() && std::isfinite(c.wall_median); }
 
@@ -260,7 +254,7 @@ std::string overlay_data(const std::string& dir, const std::vector<const CaseRes
       double res = cols.residuals.empty() ? kNaN : 0.0, drift = cols.drifts.empty() ? kNaN : 0.0;
       for (int col : cols.residuals) res = std::max(res, std::abs(cell(row, col)));
       for (int col : cols.drifts) drift = std::max(drift, std::abs(cell(row, col)));
-      out += row[0] + " " + log_cell(res) + " " + log_cell(drift) + "\n";
+      out += row[0] + " " + log_plot_cell(res) + " " + log_plot_cell(drift) + "\n";
     }
   }
   return out;
@@ -535,9 +529,9 @@ WorkPrecisionData work_precision_data(const ProblemView& p, const ProblemStyle& 
       d.has_drift = d.has_drift || (std::isfinite(c->drift) && c->drift > 0);
     }
     for (const CaseResult* c : pts_of)
-      d.text += format_exact(c->wall_median) + " " + log_cell(c->ref_error) + " " +
-                (std::isfinite(c->ref_scd) ? format_exact(c->ref_scd) : "?") + " " + log_cell(c->max_residual) +
-                " " + log_cell(c->drift) + " " + format_exact(case_size(*c)) + "\n";
+      d.text += format_exact(c->wall_median) + " " + log_plot_cell(c->ref_error) + " " +
+                (std::isfinite(c->ref_scd) ? format_exact(c->ref_scd) : "?") + " " + log_plot_cell(c->max_residual) +
+                " " + log_plot_cell(c->drift) + " " + format_exact(case_size(*c)) + "\n";
   }
   return d;
 }

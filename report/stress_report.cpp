@@ -19,10 +19,6 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 std::string sci(double v) { return format_3g(v); }
 
-std::string plot_cell(double v) { return std::isfinite(v) && v > 0 ? format_exact(v) : "?"; }
-
-std::string count_cell(long n) { return n < 0 ? std::string() : std::to_string(n); }
-
 // The wall time of a case's first repeat (what the stress tables show).
 double first_wall(const CaseResult& c) { return c.repeats.empty() ? kNaN : c.repeats[0].wall_seconds; }
 
@@ -129,8 +125,8 @@ void perturb_plots(const Cases& perturbed, StressSection& out) {
               " initial_residual max_residual recovery_time\n";
       lcs += " " + std::to_string(m % 12 + 1);
       for (const CaseResult* c : pts)
-        data += format_exact(c->perturb) + " " + plot_cell(c->initial_residual) + " " + plot_cell(c->max_residual) +
-                " " + (c->status == Status::kOk && c->recovered ? plot_cell(c->recovery_time) : "?") + "\n";
+        data += format_exact(c->perturb) + " " + log_plot_cell(c->initial_residual) + " " + log_plot_cell(c->max_residual) +
+                " " + (c->status == Status::kOk && c->recovered ? log_plot_cell(c->recovery_time) : "?") + "\n";
     }
     out.plots.push_back({"stress_perturb_" + problem, "stress_perturb.gp", data,
                          "; problem=" + gnuplot_string(problem) + "; lcs=" + gnuplot_string(lcs),
@@ -217,7 +213,7 @@ void add_long_series(LongPlots& plots, const std::string& dir, const CaseResult&
   for (size_t r = 0; r < series.rows.size(); ++r) {
     const double t = parse_number(series.get(r, "t")), e = std::abs(parse_number(series.get(r, "energy_drift")));
     if (std::isfinite(e)) running = std::max(running, e);
-    if (t > 0) data += format_exact(t) + " " + plot_cell(running) + "\n";
+    if (t > 0) data += format_exact(t) + " " + log_plot_cell(running) + "\n";
   }
 }
 
@@ -306,8 +302,8 @@ void stiff_section(std::ostream& h, const std::string& dir, const Cases& stiff, 
     for (const CaseResult* c : rows) {
       const bool ok = c->status == Status::kOk;
       has_ref = has_ref || (ok && c->ref_error > 0);
-      data += format_exact(gain_of(c->entry->params)) + " " + (ok ? plot_cell(first_wall(*c)) : "?") + " " +
-              (ok ? plot_cell(c->ref_error) : "?") + " " + (ok ? plot_cell(c->max_residual) : "?") + "\n";
+      data += format_exact(gain_of(c->entry->params)) + " " + (ok ? log_plot_cell(first_wall(*c)) : "?") + " " +
+              (ok ? log_plot_cell(c->ref_error) : "?") + " " + (ok ? log_plot_cell(c->max_residual) : "?") + "\n";
     }
   }
   h << "</table>\n";
