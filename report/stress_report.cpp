@@ -94,7 +94,7 @@ void perturb_table(std::ostream& h, const Cases& perturbed) {
     const bool rec = c->recovered;
     h << "<tr" << row_class(rec) << "><td>" << html_escape(c->entry->problem) << "</td><td>"
       << html_escape(c->entry->method) << "</td><td>" << html_escape(c->entry->integrator + " " + c->entry->setting)
-      << (c->entry->params.empty() ? "" : " " + html_escape(c->entry->params)) << "</td><td>"
+      << (c->entry->params.empty() ? "" : " ") << html_escape(c->entry->params) << "</td><td>"
       << html_escape(status_name(c->status)) << "</td><td class=\"num\">" << sci(c->initial_residual)
       << "</td><td class=\"num\">" << sci(c->max_residual) << "</td><td class=\"num\">"
       << (rec ? sci(c->recovery_time) : std::string("never")) << "</td><td>" << (rec ? "yes" : "no")
@@ -123,7 +123,8 @@ void perturb_plots(const Cases& perturbed, StressSection& out) {
       if (blocks++) data += "\n\n";
       data += gnuplot_data_title(methods[m] + " / " + pts[0]->entry->integrator) +
               " initial_residual max_residual recovery_time\n";
-      lcs += " " + std::to_string(m % 12 + 1);
+      lcs += ' ';
+      lcs += std::to_string(m % 12 + 1);
       for (const CaseResult* c : pts)
         data += format_exact(c->perturb) + " " + log_plot_cell(c->initial_residual) + " " + log_plot_cell(c->max_residual) +
                 " " + (c->status == Status::kOk && c->recovered ? log_plot_cell(c->recovery_time) : "?") + "\n";
@@ -208,7 +209,8 @@ void add_long_series(LongPlots& plots, const std::string& dir, const CaseResult&
   if (plots.blocks[sweep]++) data += "\n\n";
   data += gnuplot_data_title(c.entry->method + " (p = " + sci(c.energy_drift_exponent) + ")") +
           " running_max_abs_energy_drift\n";
-  plots.lcs[sweep] += " " + std::to_string((plots.blocks[sweep] - 1) % 12 + 1);
+  plots.lcs[sweep] += ' ';
+  plots.lcs[sweep] += std::to_string((plots.blocks[sweep] - 1) % 12 + 1);
   double running = 0;
   for (size_t r = 0; r < series.rows.size(); ++r) {
     const double t = parse_number(series.get(r, "t")), e = std::abs(parse_number(series.get(r, "energy_drift")));
@@ -298,7 +300,8 @@ void stiff_section(std::ostream& h, const std::string& dir, const Cases& stiff, 
     if (std::isnan(gain_of(rows[0]->entry->params))) continue;  // no gain axis
     if (blocks++) data += "\n\n";
     data += gnuplot_data_title(curve.substr(curve.find(": ") + 2)) + " wall_seconds ref_error max_residual\n";
-    lcs += " " + std::to_string((blocks - 1) % 12 + 1);
+    lcs += ' ';
+    lcs += std::to_string((blocks - 1) % 12 + 1);
     for (const CaseResult* c : rows) {
       const bool ok = c->status == Status::kOk;
       has_ref = has_ref || (ok && c->ref_error > 0);
