@@ -18,9 +18,11 @@
 #include <set>
 #include <sstream>
 
-#include "io/csv.hpp"
 #include "core/format.hpp"
+#include "io/csv.hpp"
+#include "io/number.hpp"
 #include "matrix/matrix.hpp"
+#include "matrix/results.hpp"
 
 namespace cstab {
 
@@ -41,7 +43,6 @@ const std::vector<std::string> kColumns = {
 constexpr unsigned kColumnCount = 20;
 
 const std::vector<std::string> kRequired = {"problem", "method", "integrator", "setting"};
-const std::set<std::string> kStatuses = {"ok", "diverged", "failed"};
 
 using Reader = io::CSVReader<kColumnCount, io::trim_chars<' ', '\t'>, io::double_quote_escape<',', '"'>,
                              io::throw_on_overflow, io::single_and_empty_line_comment<'#'>>;
@@ -100,13 +101,6 @@ std::vector<std::string> split_header(const std::string& line) {
   return cells;
 }
 
-std::string csv_cell(const std::string& s) {
-  if (s.find_first_of(",\"\n") == std::string::npos) return s;
-  std::string q = "\"";
-  for (char c : s) q += c == '"' ? std::string("\"\"") : std::string(1, c);
-  return q + "\"";
-}
-
 std::string known_columns_text() {
   std::string s;
   for (const auto& c : kColumns) s += (s.empty() ? "" : ", ") + c;
@@ -114,12 +108,9 @@ std::string known_columns_text() {
 }
 
 // Strict: the whole cell must be a finite number.
-double parse_number(const std::string& text, const std::string& at, const std::string& column) {
-  const char* begin = text.c_str();
-  char* end = nullptr;
-  const double v = std::strtod(begin, &end);
-  if (text.empty() || end == begin || *end != '\0')
-    throw UsageError(at + ": " + column + ": '" + text + "' is not a number");
+double number_or_throw(const std::string& text, const std::string& at, const std::string& column) {
+  double v = 0;
+  if (!try_parse_number(text, v)) throw UsageError(at + ": " + column + ": '" + text + "' is not a number");
   if (!std::isfinite(v)) throw UsageError(at + ": " + column + ": '" + text + "' is not finite (leave the cell empty for no bound)");
   return v;
 }
@@ -132,78 +123,18 @@ std::string fmt_bound(double v, bool lower) {
   double f = 1;
   for (int i = 0; i < 50; ++i, f *= lower ? 1 - 1e-3 : 1 + 1e-3) {
     const std::string s = fmt(v * f);
-    const double p = std::strtod(s.c_str(), nullptr);
+    const double p = parse_number(s);
     if (lower ? p <= v : p >= v) return s;
   }
   return format_exact(v);
 }
 
-// ---- the measured side: one case of a results folder ----
-
-struct CaseResult {
-  const CaseEntry* entry = nullptr;
-  bool complete = false;
-  std::string status;
-  std::string reason;
-  double max_residual = kNaN, max_final_residual = kNaN, max_energy_drift = kNaN, max_integral_drift = kNaN;
-  double ref_error = kNaN, ref_scd = kNaN;
-  double recovery_time = kNaN;  // NaN: did not recover (or the case had no consistent end)
-  double median_wall = kNaN;
-};
-
-double cell_number(const CsvTable& t, size_t row, const std::string& column) {
-  const std::string& s = t.get(row, column);
-  if (s.empty()) return kNaN;
-  char* end = nullptr;
-  const double v = std::strtod(s.c_str(), &end);
-  return (end && *end == '\0') ? v : kNaN;
-}
-
-double nan_max(double a, double b) {
-  if (std::isnan(a)) return b;
-  if (std::isnan(b)) return a;
-  return std::max(a, b);
-}
-
-CaseResult load_case(const std::string& dir, const CaseEntry& entry) {
-  CaseResult r;
-  r.entry = &entry;
-  const std::string folder = dir + "/cases/" + entry.id;
-  if (!fs::exists(folder + "/key.txt") || !fs::exists(folder + "/summary.csv")) return r;
-  const CsvTable t = read_csv(folder + "/summary.csv");
-  if (t.rows.empty()) return r;
-  r.complete = true;
-  std::vector<double> walls;
-  for (size_t i = 0; i < t.rows.size(); ++i) {
-    const std::string& st = t.get(i, "status");
-    if (r.status.empty() || (r.status == "ok" && st != "ok")) {
-      r.status = st;
-      r.reason = t.get(i, "reason");
-    }
-    r.max_residual = nan_max(r.max_residual, cell_number(t, i, "max_residual"));
-    r.max_final_residual = nan_max(r.max_final_residual, cell_number(t, i, "final_residual"));
-    r.max_energy_drift = nan_max(r.max_energy_drift, cell_number(t, i, "max_energy_drift"));
-    for (const auto& col : t.header)
-      if (col.size() > 10 && col.rfind("max_", 0) == 0 && col != "max_energy_drift" &&
-          col.compare(col.size() - 6, 6, "_drift") == 0)
-        r.max_integral_drift = nan_max(r.max_integral_drift, cell_number(t, i, col));
-    r.ref_error = nan_max(r.ref_error, cell_number(t, i, "ref_error"));
-    r.recovery_time = nan_max(r.recovery_time, cell_number(t, i, "recovery_time"));
-    const double scd = cell_number(t, i, "ref_scd");
-    if (!std::isnan(scd)) r.ref_scd = std::isnan(r.ref_scd) ? scd : std::min(r.ref_scd, scd);
-    if (st == "ok") walls.push_back(cell_number(t, i, "wall_seconds"));
-  }
-  if (!walls.empty()) {
-    std::sort(walls.begin(), walls.end());
-    const size_t n = walls.size();
-    r.median_wall = n % 2 ? walls[n / 2] : 0.5 * (walls[n / 2 - 1] + walls[n / 2]);
-  }
-  return r;
-}
+// ---- the measured side: a case of the results folder (matrix/results.hpp) ----
 
 bool matches(const ThresholdRow& row, const CaseEntry& e) {
   if (e.problem != row.problem || e.method != row.method || e.integrator != row.integrator ||
-      e.formulation != row.formulation || e.params != row.params || e.setting != row.setting)
+      e.formulation != row.formulation || !same_key_values(e.params, row.params) ||
+      !same_key_values(e.setting, row.setting))
     return false;
   if (!std::isnan(row.t_end) && e.t_end != row.t_end) return false;
   return row.sweep.empty() || e.sweep == row.sweep;
@@ -261,7 +192,7 @@ struct BoundSpec {
 
 const BoundSpec kBounds[] = {
     {"max_residual", &ThresholdRow::max_residual, &CaseResult::max_residual, false},
-    {"max_final_residual", &ThresholdRow::max_final_residual, &CaseResult::max_final_residual, false},
+    {"max_final_residual", &ThresholdRow::max_final_residual, &CaseResult::final_residual, false},
     {"max_energy_drift", &ThresholdRow::max_energy_drift, &CaseResult::max_energy_drift, false},
     {"max_integral_drift", &ThresholdRow::max_integral_drift, &CaseResult::max_integral_drift, false},
     {"max_ref_error", &ThresholdRow::max_ref_error, &CaseResult::ref_error, false},
@@ -305,17 +236,16 @@ std::string ThresholdRow::label() const {
   return s;
 }
 
-ThresholdsFile parse_thresholds(const std::string& text, const std::string& file_name) {
-  ThresholdsFile file;
-  file.name = file_name;
-  file.lines = split_lines(text);
+namespace {
+
+// The header line: its column names and 0-based positions, checked here so errors name columns.
+std::map<std::string, int> parse_header(ThresholdsFile& file, const std::string& text) {
+  const std::string& file_name = file.name;
   if (text.find('\0') != std::string::npos) {
     int line = 1;
     for (char c : text.substr(0, text.find('\0'))) line += c == '\n';
     throw UsageError(where(file_name, line, 0) + ": NUL byte: not a text file");
   }
-
-  // The header: its names and positions, checked here so errors name columns.
   int header_line = 0;
   for (size_t i = 0; i < file.lines.size(); ++i)
     if (!is_comment_line(file.lines[i])) {
@@ -336,10 +266,76 @@ ThresholdsFile parse_thresholds(const std::string& text, const std::string& file
   }
   for (const auto& c : kRequired)
     if (!position.count(c)) throw UsageError(where(file_name, header_line, 0) + ": missing required column '" + c + "'");
+  return position;
+}
 
-  // The rows, tokenized by fast-cpp-csv-parser (quoting, trimming, comments).
+// The key a row names a case by, for duplicate detection: settings and parameters in canonical form.
+std::string case_key(const ThresholdRow& row) {
+  return row.problem + " " + row.method + " " + row.integrator + " " + canonical_key_values(row.setting) + " (" +
+         row.formulation + ") " + row.sweep + " [" + canonical_key_values(row.params) + "] " +
+         (std::isnan(row.t_end) ? "" : format_short(row.t_end));
+}
+
+// One data row from its cells (by known column; nullptr: not in the file).
+ThresholdRow parse_row(const ThresholdsFile& file, std::map<std::string, int>& position, int line,
+                       char* const* cells) {
+  ThresholdRow row;
+  row.line = line;
+  row.fields.assign(file.columns.size(), "");
+  std::map<std::string, std::string> value;
+  for (unsigned k = 0; k < kColumnCount; ++k) {
+    if (!cells[k]) continue;
+    value[kColumns[k]] = cells[k];
+    row.fields[position[kColumns[k]]] = cells[k];
+  }
+  auto at = [&](const std::string& column) { return where(file.name, row.line, position[column] + 1); };
+  auto text_of = [&](const std::string& column) {
+    auto it = value.find(column);
+    return it == value.end() ? std::string() : it->second;
+  };
+  for (const auto& c : kRequired)
+    if (text_of(c).empty()) throw UsageError(at(c) + ": " + c + ": required, empty");
+  row.name = text_of("name");
+  row.sweep = text_of("sweep");
+  row.problem = text_of("problem");
+  row.method = text_of("method");
+  row.formulation = text_of("formulation");
+  row.integrator = text_of("integrator");
+  row.params = text_of("params");
+  row.setting = text_of("setting");
+  row.baseline = text_of("baseline");
+  if (!text_of("t_end").empty()) {
+    row.t_end = number_or_throw(text_of("t_end"), at("t_end"), "t_end");
+    if (!(row.t_end > 0)) throw UsageError(at("t_end") + ": t_end: must be > 0");
+  }
+  if (!text_of("status").empty()) {
+    const auto status = parse_status(text_of("status"));
+    if (!status || !is_gateable(*status))
+      throw UsageError(at("status") + ": status: '" + text_of("status") + "' is not one of ok, diverged, failed");
+    row.status = *status;
+  }
+  for (const auto& b : kBounds) {
+    const std::string s = text_of(b.column);
+    if (s.empty()) continue;
+    const double v = number_or_throw(s, at(b.column), b.column);
+    if (v < 0) throw UsageError(at(b.column) + ": " + b.column + ": " + s + " is negative (bounds are >= 0)");
+    if (std::string(b.column) == "max_time_ratio" && v == 0)
+      throw UsageError(at(b.column) + ": max_time_ratio: must be > 0");
+    row.*(b.bound) = v;
+  }
+  if (!std::isnan(row.max_time_ratio) && row.baseline.empty())
+    throw UsageError(at("max_time_ratio") + ": max_time_ratio needs a baseline (the name of another row)");
+  if (std::isnan(row.max_time_ratio) && !row.baseline.empty())
+    throw UsageError(at("baseline") + ": baseline given without max_time_ratio");
+  return row;
+}
+
+// The rows, tokenized by fast-cpp-csv-parser (quoting, trimming, comments); no duplicate case or name.
+void parse_rows(ThresholdsFile& file, const std::string& text, std::map<std::string, int>& position,
+                std::map<std::string, int>& name_line) {
+  const std::string& file_name = file.name;
   Reader reader(file_name, text.data(), text.data() + text.size());
-  std::map<std::string, int> key_line, name_line;
+  std::map<std::string, int> key_line;
   try {
     reader.read_header(io::ignore_missing_column, "name", "sweep", "problem", "method", "formulation", "integrator",
                        "params", "setting", "t_end", "status", "max_residual", "max_final_residual",
@@ -352,62 +348,16 @@ ThresholdsFile parse_thresholds(const std::string& text, const std::string& file
                            cells[9], cells[10], cells[11], cells[12], cells[13], cells[14], cells[15], cells[16],
                            cells[17], cells[18], cells[19]))
         break;
-      ThresholdRow row;
-      row.line = int(reader.get_file_line());
-      row.fields.assign(file.columns.size(), "");
-      std::map<std::string, std::string> value;
-      for (unsigned k = 0; k < kColumnCount; ++k) {
-        if (!cells[k]) continue;
-        value[kColumns[k]] = cells[k];
-        row.fields[position[kColumns[k]]] = cells[k];
-      }
-      auto at = [&](const std::string& column) { return where(file_name, row.line, position[column] + 1); };
-      auto text_of = [&](const std::string& column) {
-        auto it = value.find(column);
-        return it == value.end() ? std::string() : it->second;
-      };
-      for (const auto& c : kRequired)
-        if (text_of(c).empty()) throw UsageError(at(c) + ": " + c + ": required, empty");
-      row.name = text_of("name");
-      row.sweep = text_of("sweep");
-      row.problem = text_of("problem");
-      row.method = text_of("method");
-      row.formulation = text_of("formulation");
-      row.integrator = text_of("integrator");
-      row.params = text_of("params");
-      row.setting = text_of("setting");
-      row.baseline = text_of("baseline");
-      if (!text_of("t_end").empty()) {
-        row.t_end = parse_number(text_of("t_end"), at("t_end"), "t_end");
-        if (!(row.t_end > 0)) throw UsageError(at("t_end") + ": t_end: must be > 0");
-      }
-      if (!text_of("status").empty()) {
-        row.status = text_of("status");
-        if (!kStatuses.count(row.status))
-          throw UsageError(at("status") + ": status: '" + row.status + "' is not one of ok, diverged, failed");
-      }
-      for (const auto& b : kBounds) {
-        const std::string s = text_of(b.column);
-        if (s.empty()) continue;
-        const double v = parse_number(s, at(b.column), b.column);
-        if (v < 0) throw UsageError(at(b.column) + ": " + b.column + ": " + s + " is negative (bounds are >= 0)");
-        if (std::string(b.column) == "max_time_ratio" && v == 0)
-          throw UsageError(at(b.column) + ": max_time_ratio: must be > 0");
-        row.*(b.bound) = v;
-      }
-      if (!std::isnan(row.max_time_ratio) && row.baseline.empty())
-        throw UsageError(at("max_time_ratio") + ": max_time_ratio needs a baseline (the name of another row)");
-      if (std::isnan(row.max_time_ratio) && !row.baseline.empty())
-        throw UsageError(at("baseline") + ": baseline given without max_time_ratio");
-      const std::string key = row.label();
+      ThresholdRow row = parse_row(file, position, int(reader.get_file_line()), cells);
+      const std::string key = case_key(row);
       if (key_line.count(key))
-        throw UsageError(where(file_name, row.line, 0) + ": duplicate case " + key + " (first at line " +
+        throw UsageError(where(file_name, row.line, 0) + ": duplicate case " + row.label() + " (first at line " +
                          std::to_string(key_line[key]) + ")");
       key_line[key] = row.line;
       if (!row.name.empty()) {
         if (name_line.count(row.name))
-          throw UsageError(at("name") + ": duplicate name '" + row.name + "' (first at line " +
-                           std::to_string(name_line[row.name]) + ")");
+          throw UsageError(where(file_name, row.line, position["name"] + 1) + ": duplicate name '" + row.name +
+                           "' (first at line " + std::to_string(name_line[row.name]) + ")");
         name_line[row.name] = row.line;
       }
       file.rows.push_back(std::move(row));
@@ -423,14 +373,34 @@ ThresholdsFile parse_thresholds(const std::string& text, const std::string& file
   } catch (const io::error::base& e) {
     throw UsageError(file_name + ": " + e.what());
   }
+}
+
+// Every baseline names another row.
+void check_baselines(const ThresholdsFile& file, std::map<std::string, int>& position,
+                     const std::map<std::string, int>& name_line) {
   for (const auto& row : file.rows) {
     if (row.baseline.empty()) continue;
     if (!name_line.count(row.baseline))
-      throw UsageError(where(file_name, row.line, position["baseline"] + 1) + ": baseline '" + row.baseline +
+      throw UsageError(where(file.name, row.line, position["baseline"] + 1) + ": baseline '" + row.baseline +
                        "' is not the name of any row");
     if (row.baseline == row.name)
-      throw UsageError(where(file_name, row.line, position["baseline"] + 1) + ": a row cannot be its own baseline");
+      throw UsageError(where(file.name, row.line, position["baseline"] + 1) + ": a row cannot be its own baseline");
   }
+}
+
+}  // namespace
+
+ThresholdsFile parse_thresholds(const std::string& text, const std::string& file_name) {
+  ThresholdsFile file;
+  file.name = file_name;
+  file.lines = split_lines(text);
+  // The header: names and positions.
+  std::map<std::string, int> position = parse_header(file, text);
+  // The rows.
+  std::map<std::string, int> name_line;
+  parse_rows(file, text, position, name_line);
+  // Cross-row checks.
+  check_baselines(file, position, name_line);
   return file;
 }
 
@@ -446,15 +416,7 @@ ThresholdsFile read_thresholds_file(const std::string& path) {
 
 namespace {
 
-std::string row_text(const ThresholdRow& row) {
-  std::string line;
-  for (size_t k = 0; k < row.fields.size(); ++k) {
-    if (k) line += ',';
-    line += csv_cell(row.fields[k]);
-  }
-  line += '\n';
-  return line;
-}
+std::string row_text(const ThresholdRow& row) { return csv_line(row.fields); }
 
 }  // namespace
 
@@ -488,13 +450,13 @@ GateOutcome evaluate_gate(const ThresholdsFile& file, const std::string& dir) {
   for (size_t i = 0; i < file.rows.size(); ++i) {
     const Match m = find_case(file.rows[i], entries);
     if (m.entry) named.insert(m.entry);
-    if (m.entry) results[i] = load_case(dir, *m.entry);
+    if (m.entry) results[i] = load_case_result(dir, *m.entry);
     problems[i] = m.entry ? (results[i].complete ? "" : "case " + m.entry->id + " has no complete result")
                           : m.problem;
     if (!file.rows[i].name.empty()) by_name[file.rows[i].name] = results[i];
   }
   for (const auto& e : entries)
-    if (!named.count(&e) && kStatuses.count(load_case(dir, e).status)) ++out.unchecked_cases;  // n/a ones aside
+    if (!named.count(&e) && is_gateable(load_case_result(dir, e).status)) ++out.unchecked_cases;  // n/a ones aside
   for (size_t i = 0; i < file.rows.size(); ++i) {
     const ThresholdRow& row = file.rows[i];
     const CaseResult& r = results[i];
@@ -516,8 +478,8 @@ GateOutcome evaluate_gate(const ThresholdsFile& file, const std::string& dir) {
     {
       GateCheck c;
       c.check = "status";
-      c.value = r.status;
-      c.threshold = row.status;
+      c.value = status_name(r.status);
+      c.threshold = status_name(row.status);
       c.pass = r.status == row.status;
       if (!c.pass && !r.reason.empty()) c.note = r.reason;
       add(c);
@@ -534,12 +496,12 @@ GateOutcome evaluate_gate(const ThresholdsFile& file, const std::string& dir) {
         if (std::isnan(value)) c.note = "the case has no value for it";
       } else {
         const CaseResult& base = by_name[row.baseline];
-        if (!base.complete || std::isnan(base.median_wall) || std::isnan(r.median_wall))
+        if (!base.complete || std::isnan(base.wall_median) || std::isnan(r.wall_median))
           c.note = "no successful timing of the case or of baseline '" + row.baseline + "'";
-        else if (base.median_wall <= 0)
+        else if (base.wall_median <= 0)
           c.note = "baseline '" + row.baseline + "' took no measurable time";
         else
-          value = r.median_wall / base.median_wall;
+          value = r.wall_median / base.wall_median;
       }
       c.value = std::isnan(value) ? "n/a" : fmt(value);
       c.value_number = value;
@@ -585,10 +547,9 @@ std::string format_gate_table(const GateOutcome& outcome) {
 std::string gate_csv(const GateOutcome& outcome) {
   std::string s = "line,case,check,value,threshold,margin,result,note\n";
   for (const auto& c : outcome.checks)
-    s += std::to_string(c.line) + "," + csv_cell(c.case_label) + "," + c.check + "," +
-         csv_cell(std::isnan(c.value_number) ? c.value : format_exact(c.value_number)) + "," +
-         csv_cell(c.threshold) + "," + csv_cell(c.margin) + "," + (c.pass ? "pass" : "fail") + "," +
-         csv_cell(c.note) + "\n";
+    s += csv_line({std::to_string(c.line), c.case_label, c.check,
+                   std::isnan(c.value_number) ? c.value : format_exact(c.value_number), c.threshold, c.margin,
+                   c.pass ? "pass" : "fail", c.note});
   return s;
 }
 
@@ -627,7 +588,7 @@ std::vector<ThresholdChange> update_thresholds(ThresholdsFile& file, const std::
   std::map<std::string, size_t> by_name;
   for (size_t i = 0; i < file.rows.size(); ++i) {
     const Match m = find_case(file.rows[i], entries);
-    if (m.entry) results[i] = load_case(dir, *m.entry);
+    if (m.entry) results[i] = load_case_result(dir, *m.entry);
     if (!file.rows[i].name.empty()) by_name[file.rows[i].name] = i;
     if (!m.entry || !results[i].complete)
       notes.push_back("line " + std::to_string(file.rows[i].line) + ": " + file.rows[i].label() +
@@ -644,7 +605,7 @@ std::vector<ThresholdChange> update_thresholds(ThresholdsFile& file, const std::
       set_cell(file, row, column, text);
     };
     if (column_index(file, "status") >= 0 && !cell(row, column_index(file, "status")).empty()) {
-      change("status", r.status);
+      change("status", status_name(r.status));
       row.status = r.status;
     }
     for (const auto& b : kBounds) {
@@ -654,7 +615,7 @@ std::vector<ThresholdChange> update_thresholds(ThresholdsFile& file, const std::
         value = r.*(b.value);
       } else {
         const CaseResult& base = results[by_name[row.baseline]];
-        if (base.complete && base.median_wall > 0) value = r.median_wall / base.median_wall;
+        if (base.complete && base.wall_median > 0) value = r.wall_median / base.wall_median;
       }
       if (std::isnan(value)) {
         notes.push_back("line " + std::to_string(row.line) + ": " + row.label() + ": " + b.column +
@@ -663,7 +624,7 @@ std::vector<ThresholdChange> update_thresholds(ThresholdsFile& file, const std::
       }
       const std::string text = fmt_bound(derived_bound(b, value, factors), b.lower);
       change(b.column, text);
-      row.*(b.bound) = std::strtod(text.c_str(), nullptr);
+      row.*(b.bound) = parse_number(text);
     }
   }
   return changes;
@@ -693,8 +654,8 @@ ThresholdsFile initial_thresholds(const std::string& dir, const GateFactors& fac
     ++key_t_count[key_t_of(e)];
   }
   for (const auto& e : entries) {
-    const CaseResult r = load_case(dir, e);
-    if (!r.complete || !kStatuses.count(r.status)) continue;  // n/a (invalid), timeout, crashed: not gated
+    const CaseResult r = load_case_result(dir, e);
+    if (!r.complete || !is_gateable(r.status)) continue;  // n/a (invalid), timeout, crashed: not gated
     ThresholdRow row;
     row.line = int(file.lines.size()) + 1;
     file.lines.push_back("");  // placeholder; thresholds_text writes the row here
@@ -716,8 +677,8 @@ ThresholdsFile initial_thresholds(const std::string& dir, const GateFactors& fac
     set_cell(file, row, "params", e.params);
     set_cell(file, row, "setting", e.setting);
     if (!std::isnan(row.t_end)) set_cell(file, row, "t_end", format_short(e.t_end));
-    set_cell(file, row, "status", r.status);
-    if (r.status == "ok")
+    set_cell(file, row, "status", status_name(r.status));
+    if (r.status == Status::kOk)
       for (const auto& b : kBounds) {
         if (!b.value) continue;
         const double value = r.*(b.value);
@@ -727,7 +688,7 @@ ThresholdsFile initial_thresholds(const std::string& dir, const GateFactors& fac
         if (b.lower && value < 1) continue;  // not one correct digit: max_ref_error says it better
         const std::string text = fmt_bound(derived_bound(b, value, factors), b.lower);
         set_cell(file, row, b.column, text);
-        row.*(b.bound) = std::strtod(text.c_str(), nullptr);
+        row.*(b.bound) = parse_number(text);
       }
     file.rows.push_back(std::move(row));
   }

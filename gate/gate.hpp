@@ -10,6 +10,9 @@
 //   key:    problem, method, integrator, setting (required; a perturbed
 //           start is part of it: "step=0.001;perturb=0.001"), formulation,
 //           params (the given parameters, "a=1;b=2"; empty: defaults),
+//           (setting and params match by meaning: the same keys in any
+//           order, numbers equal as numbers, so "step=1e-3" names the case
+//           of "step=0.001"),
 //           t_end (empty: any), sweep (empty: any),
 //           name (a label other rows can name as their timing baseline)
 //   bounds: status (expected status, default ok), max_residual,
@@ -28,6 +31,7 @@
 #include <vector>
 
 #include "core/params.hpp"
+#include "matrix/results.hpp"
 
 namespace cstab {
 
@@ -36,7 +40,7 @@ struct ThresholdRow {
   std::vector<std::string> fields;  // cells in the file's column order
   std::string name, sweep, problem, method, formulation, integrator, params, setting, baseline;
   double t_end = std::numeric_limits<double>::quiet_NaN();  // NaN: any
-  std::string status = "ok";
+  Status status = Status::kOk;      // ok, diverged or failed
   double max_residual = std::numeric_limits<double>::quiet_NaN();  // NaN: not checked
   double max_final_residual = std::numeric_limits<double>::quiet_NaN();
   double max_energy_drift = std::numeric_limits<double>::quiet_NaN();

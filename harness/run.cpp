@@ -6,6 +6,7 @@
 #include <memory>
 
 #include "io/csv.hpp"
+#include "io/number.hpp"
 #include "core/format.hpp"
 
 namespace cstab {
@@ -388,7 +389,8 @@ RunResult run_case(const Problem& problem, const RunConfig& cfg, const std::stri
 
 std::vector<std::pair<std::string, std::string>> RunResult::summary_row() const {
   std::vector<std::pair<std::string, std::string>> row;
-  auto num = [](double v) { return std::isnan(v) ? std::string() : format_exact(v); };
+  // Measured values round-trip exact, "" for none (io/number.hpp); settings in shortest form.
+  const auto num = number_cell;
   row.emplace_back("problem", problem);
   row.emplace_back("formulation", formulation);
   row.emplace_back("method", method);

@@ -3,8 +3,10 @@
 #include <unistd.h>
 
 #include <cerrno>
+#include <algorithm>
 #include <csignal>
 #include <cstring>
+#include <map>
 #include <stdexcept>
 
 namespace cstab {
@@ -83,17 +85,38 @@ std::string csv_field(const std::string& s) {
   return out + "\"";
 }
 
-std::string key_value_csv(const std::vector<std::pair<std::string, std::string>>& row) {
-  std::string header, values;
-  for (size_t i = 0; i < row.size(); ++i) {
-    if (i) {
-      header += ',';
-      values += ',';
-    }
-    header += csv_field(row[i].first);
-    values += csv_field(row[i].second);
+std::string csv_line(const std::vector<std::string>& cells) {
+  std::string line;
+  for (size_t i = 0; i < cells.size(); ++i) {
+    if (i) line += ',';
+    line += csv_field(cells[i]);
   }
-  return header + "\n" + values + "\n";
+  return line + "\n";
+}
+
+std::string rows_to_csv(const std::vector<std::vector<std::pair<std::string, std::string>>>& rows) {
+  std::vector<std::string> columns;
+  std::map<std::string, size_t> position;
+  for (const auto& row : rows)
+    for (const auto& [k, v] : row)
+      if (position.emplace(k, columns.size()).second) columns.push_back(k);
+  std::string out = csv_line(columns);
+  std::vector<std::string> cells(columns.size());
+  for (const auto& row : rows) {
+    std::fill(cells.begin(), cells.end(), std::string());
+    for (const auto& [k, v] : row) cells[position[k]] = v;
+    out += csv_line(cells);
+  }
+  return out;
+}
+
+std::string key_value_csv(const std::vector<std::pair<std::string, std::string>>& row) {
+  std::vector<std::string> header, values;
+  for (const auto& [k, v] : row) {
+    header.push_back(k);
+    values.push_back(v);
+  }
+  return csv_line(header) + csv_line(values);
 }
 
 void write_key_value_csv(const std::string& path,

@@ -37,6 +37,14 @@ void remove_temporary_files();
 // Quote a CSV field if it needs it (RFC 4180).
 std::string csv_field(const std::string& s);
 
+// One CSV line (with the newline) from cells, each quoted if it needs it.
+std::string csv_line(const std::vector<std::string>& cells);
+
+// Rows of ordered (column, value) pairs whose columns may differ -> one CSV:
+// the union of the columns in order of first appearance; a row without a
+// column has an empty cell there.
+std::string rows_to_csv(const std::vector<std::vector<std::pair<std::string, std::string>>>& rows);
+
 // Header line + data row text from ordered (column, value) pairs.
 std::string key_value_csv(const std::vector<std::pair<std::string, std::string>>& row);
 

@@ -17,22 +17,12 @@
 
 #include "core/format.hpp"
 #include "harness/integrator.hpp"
+#include "io/hash.hpp"
 
 namespace cstab {
 
 std::string SourceLocation::str() const {
   return file + ":" + std::to_string(line) + ":" + std::to_string(column);
-}
-
-std::string hash_hex(const std::string& data) {
-  std::uint64_t h = 1469598103934665603ull;
-  for (unsigned char c : data) {
-    h ^= c;
-    h *= 1099511628211ull;
-  }
-  char buf[17];
-  std::snprintf(buf, sizeof buf, "%016llx", static_cast<unsigned long long>(h));
-  return buf;
 }
 
 std::string read_text_file(const std::string& path) {

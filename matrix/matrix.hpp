@@ -34,6 +34,7 @@
 
 #include "core/problem.hpp"
 #include "harness/run.hpp"
+#include "io/hash.hpp"
 
 namespace cstab {
 
@@ -134,8 +135,7 @@ std::vector<MatrixCase> select_cases(const std::vector<MatrixCase>& cases, const
 // "k/N" -> (k, N); throws UsageError.
 std::pair<int, int> parse_shard(const std::string& text);
 
-// 64-bit FNV-1a as 16 hex digits.
-std::string hash_hex(const std::string& data);
+// hash_hex (case ids): io/hash.hpp.
 
 // ---------------------------------------------------------------------------
 // Running

@@ -18,10 +18,12 @@
 #include <sstream>
 #include <thread>
 
-#include "io/csv.hpp"
 #include "core/format.hpp"
+#include "io/csv.hpp"
+#include "io/number.hpp"
 #include "matrix/matrix.hpp"
 #include "matrix/provenance.hpp"
+#include "matrix/results.hpp"
 
 namespace cstab {
 
@@ -50,31 +52,8 @@ bool file_equals(const std::string& path, const std::string& content) {
   return n == content.size() && data.compare(0, n, content) == 0;
 }
 
-// Rows with possibly different columns -> one CSV (union of columns).
-std::string rows_to_csv(const std::vector<Row>& rows) {
-  std::vector<std::string> columns;
-  std::map<std::string, size_t> position;
-  for (const auto& row : rows)
-    for (const auto& [k, v] : row)
-      if (position.emplace(k, columns.size()).second) columns.push_back(k);
-  std::string out;
-  for (size_t i = 0; i < columns.size(); ++i) out += (i ? "," : "") + csv_field(columns[i]);
-  out += "\n";
-  std::vector<const std::string*> cells(columns.size());
-  for (const auto& row : rows) {
-    std::fill(cells.begin(), cells.end(), nullptr);
-    for (const auto& [k, v] : row) cells[position[k]] = &v;
-    for (size_t i = 0; i < cells.size(); ++i) {
-      if (i) out += ',';
-      if (cells[i]) out += csv_field(*cells[i]);
-    }
-    out += "\n";
-  }
-  return out;
-}
-
 // A row for a case that produced no RunResult (crash, timeout, bad input).
-Row failure_row(const MatrixCase& c, const std::string& status, const std::string& reason) {
+Row failure_row(const MatrixCase& c, Status status, const std::string& reason) {
   const RunConfig& cfg = c.config;
   Row row;
   row.emplace_back("case_id", c.entry.id);
@@ -87,7 +66,7 @@ Row failure_row(const MatrixCase& c, const std::string& status, const std::strin
   row.emplace_back("step", cfg.step.step > 0 ? format_short(cfg.step.step) : "");
   row.emplace_back("rtol", cfg.step.rtol > 0 ? format_short(cfg.step.rtol) : "");
   row.emplace_back("atol", cfg.step.atol > 0 ? format_short(cfg.step.atol) : "");
-  row.emplace_back("status", status);
+  row.emplace_back("status", status_name(status));
   row.emplace_back("reason", reason);
   row.emplace_back("t_end", format_short(cfg.t_end));
   return row;
@@ -109,19 +88,20 @@ int run_in_worker(const MatrixCase& c, const Problem& problem, const std::string
     try {
       result = run_case(problem, cfg, r == 0 ? dir : std::string());
     } catch (const UsageError& e) {
-      rows = {failure_row(c, "invalid", e.what())};
+      rows = {failure_row(c, Status::kInvalid, e.what())};
       code = kExitInvalid;
       break;
     } catch (const std::exception& e) {
-      rows = {failure_row(c, "failed", std::string("exception: ") + e.what())};
+      rows = {failure_row(c, Status::kFailed, std::string("exception: ") + e.what())};
       code = kExitFailed;
       break;
     }
     Row row = result.summary_row();
     row.insert(row.begin(), {{"case_id", c.entry.id}, {"repeat", std::to_string(r)}});
     rows.push_back(std::move(row));
-    if (result.status != "ok") {  // repeats only time successful runs
-      code = result.status == "diverged" ? kExitDiverged : kExitFailed;
+    const Status status = status_from_cell(result.status);
+    if (status != Status::kOk) {  // repeats only time successful runs
+      code = status == Status::kDiverged ? kExitDiverged : kExitFailed;
       break;
     }
     // A long run is timed well enough once.
@@ -214,25 +194,22 @@ const char* signal_name(int sig) {
 
 std::string stop_signal_name(int sig) { return signal_name(sig); }
 
-MatrixRunStats run_matrix(const std::vector<MatrixCase>& cases, const MatrixRunOptions& opt, std::ostream& log,
-                          bool tty) {
-  const auto start = Clock::now();
-  auto elapsed = [&] { return std::chrono::duration<double>(Clock::now() - start).count(); };
-  MatrixRunStats stats;
-  stats.total = cases.size();
-  const StopSignals stop_signals;
+namespace {
 
+// The folder's cases.csv and matrix.toml, written before anything runs.
+void prepare_folder(const std::vector<MatrixCase>& cases, const MatrixRunOptions& opt) {
   std::error_code ec;
   fs::create_directories(opt.out_dir + "/cases", ec);
   if (ec) throw UsageError("--out " + opt.out_dir + ": cannot create folder: " + ec.message());
-  {
-    std::vector<CaseEntry> entries;
-    for (const auto& c : cases) entries.push_back(c.entry);
-    write_manifest(opt.out_dir + "/cases.csv", entries, opt.selected_cases);
-    write_file_atomic(opt.out_dir + "/matrix.toml", opt.matrix_text);
-  }
+  std::vector<CaseEntry> entries;
+  for (const auto& c : cases) entries.push_back(c.entry);
+  write_manifest(opt.out_dir + "/cases.csv", entries, opt.selected_cases);
+  write_file_atomic(opt.out_dir + "/matrix.toml", opt.matrix_text);
+}
 
-  // ---- what is cached ----
+// The cases without a cached result (same configuration and binary), longest first.
+std::vector<const MatrixCase*> uncached_cases(const std::vector<MatrixCase>& cases, const MatrixRunOptions& opt,
+                                              MatrixRunStats& stats, std::ostream& log) {
   std::vector<const MatrixCase*> todo;
   for (const auto& c : cases) {
     const std::string dir = case_folder(opt.out_dir, c.entry.id);
@@ -245,214 +222,282 @@ MatrixRunStats run_matrix(const std::vector<MatrixCase>& cases, const MatrixRunO
   if (stats.cached)
     log << "matrix: " << stats.cached << " of " << stats.total
         << " cases cached (same configuration and binary, result in " << opt.out_dir << "/cases): not rerun\n";
-  if (todo.empty()) {
-    stats.seconds = elapsed();
-    return stats;
-  }
   // Longest first, so the pool does not end waiting on one long case.
   std::stable_sort(todo.begin(), todo.end(),
                    [](const MatrixCase* a, const MatrixCase* b) { return a->cost_estimate > b->cost_estimate; });
+  return todo;
+}
 
-  // ---- reference solutions: computed once here, inherited by every worker ----
-  {
-    std::set<std::pair<std::string, double>> done;
-    for (const MatrixCase* c : todo) {
-      if (g_stop_signal) break;
-      const Problem& p = opt.find_problem(c->config.problem);
-      const double t = c->config.ref_time < 0 ? p.info().reference_time : c->config.ref_time;
-      if (!(t > 0) || t > c->config.t_end || !done.insert({c->config.problem, t}).second) continue;
-      std::vector<double> buf(p.info().coordinates.size());
-      p.reference(t, buf.data());
+// Reference solutions: computed once here, inherited by every worker.
+void compute_references(const std::vector<const MatrixCase*>& todo, const MatrixRunOptions& opt) {
+  std::set<std::pair<std::string, double>> done;
+  for (const MatrixCase* c : todo) {
+    if (g_stop_signal) break;
+    const Problem& p = opt.find_problem(c->config.problem);
+    const double t = c->config.ref_time < 0 ? p.info().reference_time : c->config.ref_time;
+    if (!(t > 0) || t > c->config.t_end || !done.insert({c->config.problem, t}).second) continue;
+    std::vector<double> buf(p.info().coordinates.size());
+    p.reference(t, buf.data());
+  }
+}
+
+// The status of a finished worker and why (for the ones without a RunResult).
+std::pair<Status, std::string> worker_outcome(const MatrixCase& c, int wait_status, bool timed_out) {
+  if (timed_out) return {Status::kTimeout, "killed after " + format_short(c.timeout) + " s (timeout)"};
+  if (WIFEXITED(wait_status)) {
+    switch (WEXITSTATUS(wait_status)) {
+      case kExitOk: return {Status::kOk, ""};
+      case kExitDiverged: return {Status::kDiverged, ""};
+      case kExitFailed: return {Status::kFailed, ""};
+      case kExitInvalid: return {Status::kInvalid, ""};
+      default: return {Status::kCrashed, "worker exited with code " + std::to_string(WEXITSTATUS(wait_status))};
     }
   }
+  return {Status::kCrashed, std::string("worker killed by signal ") + std::to_string(WTERMSIG(wait_status)) + " (" +
+                                strsignal(WTERMSIG(wait_status)) + ")"};
+}
 
-  double cost_total = 0, cost_done = 0;
-  for (const MatrixCase* c : todo) cost_total += c->cost_estimate;
-  const size_t jobs = size_t(std::max(1, opt.jobs));
-  std::map<pid_t, Running> running;
-  size_t next = 0, finished = 0;
-  auto last_draw = Clock::now() - std::chrono::seconds(1);
+// The pool of workers over the uncached cases: starts, reaps, times out, stops.
+class WorkerPool {
+ public:
+  WorkerPool(std::vector<const MatrixCase*> todo, const MatrixRunOptions& opt, MatrixRunStats& stats,
+             std::ostream& log, bool tty, Clock::time_point start)
+      : todo_(std::move(todo)), opt_(opt), stats_(stats), log_(log), tty_(tty), start_(start) {
+    for (const MatrixCase* c : todo_) cost_total_ += c->cost_estimate;
+  }
 
-  auto progress_line = [&] {
-    const double t = elapsed();
-    const double eta = cost_done > 0 ? t * (cost_total - cost_done) / cost_done : NAN;
-    std::ostringstream s;
-    s << "[" << (stats.cached + finished) << "/" << stats.total << "] " << clock_text(t) << " elapsed, ETA "
-      << (finished == todo.size() ? "0:00" : clock_text(eta)) << ", " << stats.failed << " failed, "
-      << stats.diverged << " diverged, " << stats.not_applicable << " n/a, " << stats.cached << " cached, "
-      << running.size() << " running";
-    return s.str();
-  };
-  auto draw = [&](bool force) {
-    if (!tty) return;
-    if (!force && Clock::now() - last_draw < std::chrono::milliseconds(200)) return;
-    last_draw = Clock::now();
-    log << "\r\033[K" << progress_line() << std::flush;
-  };
-
-  // A worker that did not finish (stopped by a signal): no result, its
-  // partial folder removed, run again next time.
-  auto unfinished = [&](const MatrixCase& c, const std::string& why) {
-    fs::remove_all(case_folder(opt.out_dir, c.entry.id), ec);
-    ++stats.unfinished;
-    ++finished;
-    if (tty) log << "\r\033[K";
-    log << "[" << (stats.cached + finished) << "/" << stats.total << "] unfinished " << c.entry.label() << "  ("
-        << c.entry.id << ")\n    " << why << ": not recorded, runs again next time\n" << std::flush;
-  };
-
-  auto record = [&](const MatrixCase& c, int wait_status, double seconds, bool timed_out) {
-    const std::string dir = case_folder(opt.out_dir, c.entry.id);
-    std::string outcome, reason;
-    if (!timed_out && WIFSIGNALED(wait_status) && is_stop_signal(WTERMSIG(wait_status))) {
-      unfinished(c, std::string("worker stopped by ") + signal_name(WTERMSIG(wait_status)));
-      return;
-    }
-    if (timed_out) {
-      outcome = "timeout";
-      reason = "killed after " + format_short(c.timeout) + " s (timeout)";
-    } else if (WIFEXITED(wait_status)) {
-      switch (WEXITSTATUS(wait_status)) {
-        case kExitOk: outcome = "ok"; break;
-        case kExitDiverged: outcome = "diverged"; break;
-        case kExitFailed: outcome = "failed"; break;
-        case kExitInvalid: outcome = "invalid"; break;
-        default:
-          outcome = "crashed";
-          reason = "worker exited with code " + std::to_string(WEXITSTATUS(wait_status));
-      }
-    } else if (WIFSIGNALED(wait_status)) {
-      outcome = "crashed";
-      reason = std::string("worker killed by signal ") + std::to_string(WTERMSIG(wait_status)) + " (" +
-               strsignal(WTERMSIG(wait_status)) + ")";
-    }
-    if (outcome == "crashed" || outcome == "timeout") {
-      try {
-        write_result(dir, {failure_row(c, outcome, reason)}, cache_key(c, opt.binary_id));
-      } catch (const std::exception& e) {
-        reason += "; cannot record: " + std::string(e.what());
-      }
-    }
-    const bool failure = outcome != "ok" && outcome != "diverged" && outcome != "invalid";
-    if (outcome == "diverged") ++stats.diverged;
-    if (outcome == "invalid") ++stats.not_applicable;
-    if (failure) ++stats.failed;
-    if (outcome != "ok" && outcome != "diverged") {
-      if (reason.empty()) {
-        try {
-          reason = read_csv(dir + "/summary.csv").get(0, "reason");
-        } catch (const std::exception&) {
-        }
-      }
-    }
-    ++stats.run;
-    ++finished;
-    cost_done += c.cost_estimate;
-    std::ostringstream line;
-    char head[96];
-    const double t = elapsed();
-    const std::string eta = finished == todo.size() ? "0:00" : clock_text(t * (cost_total - cost_done) / cost_done);
-    std::snprintf(head, sizeof head, "[%zu/%zu %s, ETA %s] %-8s %7.2fs  ", stats.cached + finished, stats.total,
-                  clock_text(t).c_str(), eta.c_str(), outcome == "invalid" ? "n/a" : outcome.c_str(), seconds);
-    line << head << c.entry.label() << "  (" << c.entry.id << ")";
-    if (!reason.empty() && outcome != "ok" && outcome != "diverged") line << "\n    " << reason;
-    if (tty) {
-      if (failure) log << "\r\033[K" << line.str() << "\n";
-      draw(true);
-    } else {
-      log << line.str() << "\n" << std::flush;
-    }
-  };
-
-  while (!g_stop_signal && (next < todo.size() || !running.empty())) {
-    while (!g_stop_signal && running.size() < jobs && next < todo.size()) {
-      const MatrixCase& c = *todo[next++];
-      const std::string dir = case_folder(opt.out_dir, c.entry.id);
-      fs::remove_all(dir, ec);  // nothing stale survives: incomplete until the worker writes key.txt
-      fs::create_directories(dir, ec);
-      const std::string key = cache_key(c, opt.binary_id);
-      const Problem& problem = opt.find_problem(c.config.problem);
-      log.flush();
-      std::fflush(nullptr);
-      StopSignals::block(true);
-      const pid_t pid = ::fork();
-      if (pid == 0) {
-        StopSignals::defaults_in_child();
-        int code = kExitFailed;
-        try {
-          code = run_in_worker(c, problem, dir, key);
-        } catch (...) {
-          code = 99;
-        }
-        std::fflush(nullptr);
-        ::_exit(code);
-      }
-      StopSignals::block(false);
-      if (pid < 0) throw std::runtime_error(std::string("fork failed: ") + std::strerror(errno));
-      running[pid] = {&c, Clock::now()};
+  // Until every case ran or a stop signal came.
+  void run() {
+    const size_t jobs = size_t(std::max(1, opt_.jobs));
+    while (!g_stop_signal && (next_ < todo_.size() || !running_.empty())) {
+      while (!g_stop_signal && running_.size() < jobs && next_ < todo_.size()) start_worker(*todo_[next_++]);
+      if (reap_one()) continue;
+      kill_timed_out();
       draw(false);
-    }
-    int status = 0;
-    const pid_t pid = ::waitpid(-1, &status, WNOHANG);
-    if (pid > 0) {
-      auto it = running.find(pid);
-      if (it == running.end()) continue;  // not ours
-      const Running r = it->second;
-      running.erase(it);
-      record(*r.c, status, std::chrono::duration<double>(Clock::now() - r.start).count(), false);
-      continue;
-    }
-    // Timeouts.
-    for (auto it = running.begin(); it != running.end();) {
-      const double age = std::chrono::duration<double>(Clock::now() - it->second.start).count();
-      if (it->second.c->timeout > 0 && age > it->second.c->timeout) {
-        ::kill(it->first, SIGKILL);
-        ::waitpid(it->first, &status, 0);
-        const Running r = it->second;
-        it = running.erase(it);
-        record(*r.c, status, age, true);
-      } else {
-        ++it;
-      }
-    }
-    draw(false);
-    std::this_thread::sleep_for(std::chrono::milliseconds(5));
-  }
-  if (g_stop_signal) {
-    // Stop: nothing new starts; running workers get SIGTERM, SIGKILL after
-    // a grace period. One that still exits on its own has finished (its
-    // key.txt is written) and is recorded; the others leave no folder.
-    stats.interrupted_by = g_stop_signal;
-    if (tty) log << "\r\033[K";
-    log << "matrix: " << signal_name(stats.interrupted_by) << " received: stopping " << running.size()
-        << " running cases; " << (todo.size() - next) << " not started\n" << std::flush;
-    for (const auto& [pid, r] : running) ::kill(pid, SIGTERM);
-    const auto deadline = Clock::now() + std::chrono::seconds(3);
-    while (!running.empty()) {
-      int status = 0;
-      const pid_t pid = ::waitpid(-1, &status, WNOHANG);
-      if (pid > 0) {
-        auto it = running.find(pid);
-        if (it == running.end()) continue;
-        const Running r = it->second;
-        running.erase(it);
-        record(*r.c, status, std::chrono::duration<double>(Clock::now() - r.start).count(), false);
-        continue;
-      }
-      if (Clock::now() > deadline) {
-        for (auto it = running.begin(); it != running.end(); it = running.erase(it)) {
-          ::kill(it->first, SIGKILL);
-          ::waitpid(it->first, &status, 0);
-          unfinished(*it->second.c, "worker did not stop within 3 s of SIGTERM: killed");
-        }
-        break;
-      }
       std::this_thread::sleep_for(std::chrono::milliseconds(5));
     }
-    stats.unfinished += todo.size() - next;
   }
-  stats.seconds = elapsed();
-  if (tty) log << "\r\033[K" << progress_line() << "\n";
+
+  // After a stop signal: SIGTERM to the running workers, SIGKILL after a grace period.
+  void stop();
+
+  // The final progress line.
+  void finish() {
+    if (tty_) log_ << "\r\033[K" << progress_line() << "\n";
+  }
+
+ private:
+  double elapsed() const { return std::chrono::duration<double>(Clock::now() - start_).count(); }
+  std::string eta_text() const {
+    return finished_ == todo_.size() ? "0:00" : clock_text(elapsed() * (cost_total_ - cost_done_) / cost_done_);
+  }
+  std::string progress_line() const;
+  void draw(bool force);
+  void start_worker(const MatrixCase& c);
+  bool reap_one();
+  void kill_timed_out();
+  void unfinished(const MatrixCase& c, const std::string& why);
+  void record(const MatrixCase& c, int wait_status, double seconds, bool timed_out);
+  void report_line(const MatrixCase& c, Status outcome, const std::string& reason, double seconds, bool failure);
+
+  std::vector<const MatrixCase*> todo_;
+  const MatrixRunOptions& opt_;
+  MatrixRunStats& stats_;
+  std::ostream& log_;
+  const bool tty_;
+  const Clock::time_point start_;
+  std::map<pid_t, Running> running_;
+  size_t next_ = 0, finished_ = 0;
+  double cost_total_ = 0, cost_done_ = 0;
+  Clock::time_point last_draw_ = Clock::now() - std::chrono::seconds(1);
+};
+
+std::string WorkerPool::progress_line() const {
+  const double t = elapsed();
+  const double eta = cost_done_ > 0 ? t * (cost_total_ - cost_done_) / cost_done_ : NAN;
+  std::ostringstream s;
+  s << "[" << (stats_.cached + finished_) << "/" << stats_.total << "] " << clock_text(t) << " elapsed, ETA "
+    << (finished_ == todo_.size() ? "0:00" : clock_text(eta)) << ", " << stats_.failed << " failed, "
+    << stats_.diverged << " diverged, " << stats_.not_applicable << " n/a, " << stats_.cached << " cached, "
+    << running_.size() << " running";
+  return s.str();
+}
+
+void WorkerPool::draw(bool force) {
+  if (!tty_) return;
+  if (!force && Clock::now() - last_draw_ < std::chrono::milliseconds(200)) return;
+  last_draw_ = Clock::now();
+  log_ << "\r\033[K" << progress_line() << std::flush;
+}
+
+// Forks a worker for `c` in a fresh case folder.
+void WorkerPool::start_worker(const MatrixCase& c) {
+  std::error_code ec;
+  const std::string dir = case_folder(opt_.out_dir, c.entry.id);
+  fs::remove_all(dir, ec);  // nothing stale survives: incomplete until the worker writes key.txt
+  fs::create_directories(dir, ec);
+  const std::string key = cache_key(c, opt_.binary_id);
+  const Problem& problem = opt_.find_problem(c.config.problem);
+  log_.flush();
+  std::fflush(nullptr);
+  StopSignals::block(true);
+  const pid_t pid = ::fork();
+  if (pid == 0) {
+    StopSignals::defaults_in_child();
+    int code = kExitFailed;
+    try {
+      code = run_in_worker(c, problem, dir, key);
+    } catch (...) {
+      code = 99;
+    }
+    std::fflush(nullptr);
+    ::_exit(code);
+  }
+  StopSignals::block(false);
+  if (pid < 0) throw std::runtime_error(std::string("fork failed: ") + std::strerror(errno));
+  running_[pid] = {&c, Clock::now()};
+  draw(false);
+}
+
+// Records a worker that exited, if one did; false if none had.
+bool WorkerPool::reap_one() {
+  int status = 0;
+  const pid_t pid = ::waitpid(-1, &status, WNOHANG);
+  if (pid <= 0) return false;
+  auto it = running_.find(pid);
+  if (it == running_.end()) return true;  // not ours
+  const Running r = it->second;
+  running_.erase(it);
+  record(*r.c, status, std::chrono::duration<double>(Clock::now() - r.start).count(), false);
+  return true;
+}
+
+// Kills and records the workers past their case's timeout.
+void WorkerPool::kill_timed_out() {
+  for (auto it = running_.begin(); it != running_.end();) {
+    const double age = std::chrono::duration<double>(Clock::now() - it->second.start).count();
+    if (it->second.c->timeout > 0 && age > it->second.c->timeout) {
+      int status = 0;
+      ::kill(it->first, SIGKILL);
+      ::waitpid(it->first, &status, 0);
+      const Running r = it->second;
+      it = running_.erase(it);
+      record(*r.c, status, age, true);
+    } else {
+      ++it;
+    }
+  }
+}
+
+// A worker that did not finish (stopped by a signal): no result, its
+// partial folder removed, run again next time.
+void WorkerPool::unfinished(const MatrixCase& c, const std::string& why) {
+  std::error_code ec;
+  fs::remove_all(case_folder(opt_.out_dir, c.entry.id), ec);
+  ++stats_.unfinished;
+  ++finished_;
+  if (tty_) log_ << "\r\033[K";
+  log_ << "[" << (stats_.cached + finished_) << "/" << stats_.total << "] unfinished " << c.entry.label() << "  ("
+       << c.entry.id << ")\n    " << why << ": not recorded, runs again next time\n" << std::flush;
+}
+
+// A finished worker: its result recorded (written here for crashes and timeouts), counted, printed.
+void WorkerPool::record(const MatrixCase& c, int wait_status, double seconds, bool timed_out) {
+  if (!timed_out && WIFSIGNALED(wait_status) && is_stop_signal(WTERMSIG(wait_status))) {
+    unfinished(c, std::string("worker stopped by ") + signal_name(WTERMSIG(wait_status)));
+    return;
+  }
+  const std::string dir = case_folder(opt_.out_dir, c.entry.id);
+  auto [outcome, reason] = worker_outcome(c, wait_status, timed_out);
+  if (outcome == Status::kCrashed || outcome == Status::kTimeout) {
+    try {
+      write_result(dir, {failure_row(c, outcome, reason)}, cache_key(c, opt_.binary_id));
+    } catch (const std::exception& e) {
+      reason += "; cannot record: " + std::string(e.what());
+    }
+  }
+  const bool failure = outcome != Status::kOk && outcome != Status::kDiverged && outcome != Status::kInvalid;
+  if (outcome == Status::kDiverged) ++stats_.diverged;
+  if (outcome == Status::kInvalid) ++stats_.not_applicable;
+  if (failure) ++stats_.failed;
+  if (outcome != Status::kOk && outcome != Status::kDiverged && reason.empty()) {
+    const CaseResult result = load_case_result(opt_.out_dir, c.entry);
+    if (result.complete) reason = result.reason;
+  }
+  ++stats_.run;
+  ++finished_;
+  cost_done_ += c.cost_estimate;
+  report_line(c, outcome, reason, seconds, failure);
+}
+
+// "[k/N elapsed, ETA] status seconds label (id)" and the reason of a failure.
+void WorkerPool::report_line(const MatrixCase& c, Status outcome, const std::string& reason, double seconds,
+                             bool failure) {
+  std::ostringstream line;
+  char head[96];
+  std::snprintf(head, sizeof head, "[%zu/%zu %s, ETA %s] %-8s %7.2fs  ", stats_.cached + finished_, stats_.total,
+                clock_text(elapsed()).c_str(), eta_text().c_str(),
+                outcome == Status::kInvalid ? "n/a" : status_name(outcome), seconds);
+  line << head << c.entry.label() << "  (" << c.entry.id << ")";
+  if (!reason.empty() && outcome != Status::kOk && outcome != Status::kDiverged) line << "\n    " << reason;
+  if (tty_) {
+    if (failure) log_ << "\r\033[K" << line.str() << "\n";
+    draw(true);
+  } else {
+    log_ << line.str() << "\n" << std::flush;
+  }
+}
+
+// Stop: nothing new starts; running workers get SIGTERM, SIGKILL after
+// a grace period. One that still exits on its own has finished (its
+// key.txt is written) and is recorded; the others leave no folder.
+void WorkerPool::stop() {
+  stats_.interrupted_by = g_stop_signal;
+  if (tty_) log_ << "\r\033[K";
+  log_ << "matrix: " << signal_name(stats_.interrupted_by) << " received: stopping " << running_.size()
+       << " running cases; " << (todo_.size() - next_) << " not started\n" << std::flush;
+  for (const auto& [pid, r] : running_) ::kill(pid, SIGTERM);
+  const auto deadline = Clock::now() + std::chrono::seconds(3);
+  while (!running_.empty()) {
+    if (reap_one()) continue;
+    if (Clock::now() > deadline) {
+      for (auto it = running_.begin(); it != running_.end(); it = running_.erase(it)) {
+        int status = 0;
+        ::kill(it->first, SIGKILL);
+        ::waitpid(it->first, &status, 0);
+        unfinished(*it->second.c, "worker did not stop within 3 s of SIGTERM: killed");
+      }
+      break;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  stats_.unfinished += todo_.size() - next_;
+}
+
+}  // namespace
+
+MatrixRunStats run_matrix(const std::vector<MatrixCase>& cases, const MatrixRunOptions& opt, std::ostream& log,
+                          bool tty) {
+  const auto start = Clock::now();
+  MatrixRunStats stats;
+  stats.total = cases.size();
+  const StopSignals stop_signals;
+  // The manifest and the matrix first.
+  prepare_folder(cases, opt);
+  // What is cached is not rerun.
+  std::vector<const MatrixCase*> todo = uncached_cases(cases, opt, stats, log);
+  if (todo.empty()) {
+    stats.seconds = std::chrono::duration<double>(Clock::now() - start).count();
+    return stats;
+  }
+  // References once, before the fork.
+  compute_references(todo, opt);
+  // The pool, until done or stopped.
+  WorkerPool pool(std::move(todo), opt, stats, log, tty, start);
+  pool.run();
+  if (g_stop_signal) pool.stop();
+  stats.seconds = std::chrono::duration<double>(Clock::now() - start).count();
+  pool.finish();
   return stats;
 }
 
@@ -503,8 +548,17 @@ std::vector<CaseEntry> read_manifest(const std::string& path, size_t* selected_c
   std::vector<CaseEntry> out;
   if (selected_cases) *selected_cases = 0;
   for (size_t i = 0; i < t.rows.size(); ++i) {
+    // A number cell (io/number.hpp); `whole`: a non-negative integer.
+    auto number = [&](const char* col, bool whole) {
+      double v = 0;
+      const std::string& text = t.get(i, col);
+      if (!try_parse_number(text, v) || !std::isfinite(v) || (whole && (v < 0 || v != std::floor(v))))
+        throw UsageError(path + ": row " + std::to_string(i + 2) + ": " + col + ": '" + text + "' is not " +
+                         (whole ? "a count" : "a number"));
+      return v;
+    };
     CaseEntry e;
-    e.index = std::stoul(t.get(i, "index"));
+    e.index = size_t(number("index", true));
     e.id = t.get(i, "case_id");
     e.sweep = t.get(i, "sweep");
     e.problem = t.get(i, "problem");
@@ -513,12 +567,12 @@ std::vector<CaseEntry> read_manifest(const std::string& path, size_t* selected_c
     e.integrator = t.get(i, "integrator");
     e.params = t.get(i, "params");
     e.setting = t.get(i, "setting");
-    e.t_end = std::stod(t.get(i, "t_end"));
-    e.repeats = std::stoi(t.get(i, "repeats"));
+    e.t_end = number("t_end", false);
+    e.repeats = int(number("repeats", true));
     e.work_precision = t.get(i, "work_precision") == "1";
     e.overlay = t.get(i, "overlay") == "1";
     e.curve = t.get(i, "curve");
-    if (selected_cases && !t.get(i, "selected_cases").empty()) *selected_cases = std::stoul(t.get(i, "selected_cases"));
+    if (selected_cases && !t.get(i, "selected_cases").empty()) *selected_cases = size_t(number("selected_cases", true));
     out.push_back(std::move(e));
   }
   return out;
@@ -528,23 +582,16 @@ size_t write_matrix_summary(const std::string& dir, const std::vector<CaseEntry>
   std::vector<Row> rows;
   size_t missing = 0;
   for (const auto& e : entries) {
-    const std::string folder = case_folder(dir, e.id);
-    if (!fs::exists(folder + "/key.txt")) {
+    const CaseResult c = load_case_result(dir, e);
+    if (!c.complete) {
       ++missing;
       continue;
     }
-    CsvTable t;
-    try {
-      t = read_csv(folder + "/summary.csv");
-    } catch (const std::exception&) {
-      ++missing;
-      continue;
-    }
-    for (const auto& cells : t.rows) {
+    for (const auto& cells : c.rows) {  // the case's rows as written, with the sweep after "repeat"
       Row row;
-      for (size_t i = 0; i < t.header.size(); ++i) {
-        row.emplace_back(t.header[i], i < cells.size() ? cells[i] : "");
-        if (t.header[i] == "repeat") row.emplace_back("sweep", e.sweep);
+      for (size_t i = 0; i < c.columns.size(); ++i) {
+        row.emplace_back(c.columns[i], i < cells.size() ? cells[i] : "");
+        if (c.columns[i] == "repeat") row.emplace_back("sweep", e.sweep);
       }
       rows.push_back(std::move(row));
     }
@@ -556,64 +603,63 @@ size_t write_matrix_summary(const std::string& dir, const std::vector<CaseEntry>
   return missing;
 }
 
-size_t merge_results(const std::string& out_dir, const std::vector<std::string>& shard_dirs, std::ostream& log) {
-  if (shard_dirs.empty()) throw UsageError("give at least one shard folder");
+namespace {
+
+// What the shard folders of a merge hold together.
+struct Shards {
   std::string matrix_text;
   std::map<size_t, std::pair<CaseEntry, std::string>> by_index;  // index -> entry, source folder
   size_t selected_cases = 0;
   std::set<std::string> binaries;
-  Provenance merged;
-  for (size_t s = 0; s < shard_dirs.size(); ++s) {
-    const std::string& dir = shard_dirs[s];
-    std::error_code same_ec;
-    if (fs::equivalent(dir, out_dir, same_ec))
-      throw UsageError("the output folder " + out_dir + " is also a shard folder");
-    std::string text;
-    try {
-      text = read_text_file(dir + "/matrix.toml");
-    } catch (const std::exception&) {
-      throw UsageError(dir + " is not a matrix results folder (no matrix.toml)");
-    }
-    if (s == 0)
-      matrix_text = text;
-    else if (text != matrix_text)
-      throw UsageError(dir + " ran a different matrix than " + shard_dirs[0] +
-                       " (matrix.toml differs)");
-    size_t n = 0;
-    std::vector<CaseEntry> entries;
-    try {
-      entries = read_manifest(dir + "/cases.csv", &n);
-    } catch (const std::runtime_error& e) {
-      throw UsageError(dir + ": " + e.what());
-    }
-    if (n) selected_cases = n;
-    for (auto& e : entries) {
-      auto [it, inserted] = by_index.emplace(e.index, std::make_pair(e, dir));
-      if (!inserted && it->second.first.id != e.id)
-        throw UsageError("case " + std::to_string(e.index) + " differs between " + it->second.second +
-                         " and " + dir);
-    }
-    try {
-      for (auto [k, v] : parse_provenance(read_text_file(dir + "/provenance.txt"))) {
-        if (k == "binary_identity") binaries.insert(v);
-        merged.emplace_back("shard" + std::to_string(s + 1) + "." + k, v);
-      }
-    } catch (const std::exception&) {
-    }
-  }
-  if (binaries.size() > 1)
-    log << "merge: warning: the shards were run by " << binaries.size() << " different binaries\n";
+  Provenance provenance;  // every shard's, keys prefixed "shard<k>."
+};
 
-  std::error_code ec;
-  fs::create_directories(out_dir + "/cases", ec);
-  if (ec) throw UsageError("cannot create " + out_dir + ": " + ec.message());
+// Adds shard `s` (folder `dir`): same matrix as the first, consistent case ids.
+void read_shard(Shards& shards, const std::string& out_dir, const std::vector<std::string>& shard_dirs, size_t s) {
+  const std::string& dir = shard_dirs[s];
+  std::error_code same_ec;
+  if (fs::equivalent(dir, out_dir, same_ec)) throw UsageError("the output folder " + out_dir + " is also a shard folder");
+  std::string text;
+  try {
+    text = read_text_file(dir + "/matrix.toml");
+  } catch (const std::exception&) {
+    throw UsageError(dir + " is not a matrix results folder (no matrix.toml)");
+  }
+  if (s == 0)
+    shards.matrix_text = text;
+  else if (text != shards.matrix_text)
+    throw UsageError(dir + " ran a different matrix than " + shard_dirs[0] + " (matrix.toml differs)");
+  size_t n = 0;
   std::vector<CaseEntry> entries;
+  try {
+    entries = read_manifest(dir + "/cases.csv", &n);
+  } catch (const std::runtime_error& e) {
+    throw UsageError(dir + ": " + e.what());
+  }
+  if (n) shards.selected_cases = n;
+  for (auto& e : entries) {
+    auto [it, inserted] = shards.by_index.emplace(e.index, std::make_pair(e, dir));
+    if (!inserted && it->second.first.id != e.id)
+      throw UsageError("case " + std::to_string(e.index) + " differs between " + it->second.second + " and " + dir);
+  }
+  try {
+    for (auto [k, v] : parse_provenance(read_text_file(dir + "/provenance.txt"))) {
+      if (k == "binary_identity") shards.binaries.insert(v);
+      shards.provenance.emplace_back("shard" + std::to_string(s + 1) + "." + k, v);
+    }
+  } catch (const std::exception&) {
+  }
+}
+
+// Copies every complete case folder not already in out_dir (key.txt last); returns how many.
+size_t copy_complete_cases(const std::string& out_dir, const Shards& shards, std::vector<CaseEntry>& entries) {
+  std::error_code ec;
   size_t copied = 0;
-  for (const auto& [index, entry_source] : by_index) {
+  for (const auto& [index, entry_source] : shards.by_index) {
     const auto& [e, source] = entry_source;
     entries.push_back(e);
+    if (!load_case_result(source, e).complete) continue;  // counted by write_matrix_summary
     const std::string from = case_folder(source, e.id), to = case_folder(out_dir, e.id);
-    if (!fs::exists(from + "/key.txt")) continue;  // counted by write_matrix_summary
     const std::string key = read_text_file(from + "/key.txt");
     if (file_equals(to + "/key.txt", key)) continue;
     fs::create_directories(to, ec);
@@ -625,14 +671,33 @@ size_t merge_results(const std::string& out_dir, const std::vector<std::string>&
     write_file_atomic(to + "/key.txt", key);
     ++copied;
   }
-  write_file_atomic(out_dir + "/matrix.toml", matrix_text);
-  write_manifest(out_dir + "/cases.csv", entries, selected_cases);
+  return copied;
+}
+
+}  // namespace
+
+size_t merge_results(const std::string& out_dir, const std::vector<std::string>& shard_dirs, std::ostream& log) {
+  if (shard_dirs.empty()) throw UsageError("give at least one shard folder");
+  // Read and check every shard.
+  Shards shards;
+  for (size_t s = 0; s < shard_dirs.size(); ++s) read_shard(shards, out_dir, shard_dirs, s);
+  if (shards.binaries.size() > 1)
+    log << "merge: warning: the shards were run by " << shards.binaries.size() << " different binaries\n";
+  // Copy the complete cases.
+  std::error_code ec;
+  fs::create_directories(out_dir + "/cases", ec);
+  if (ec) throw UsageError("cannot create " + out_dir + ": " + ec.message());
+  std::vector<CaseEntry> entries;
+  const size_t copied = copy_complete_cases(out_dir, shards, entries);
+  // The union manifest, the matrix, provenance of every shard, summary.csv.
+  write_file_atomic(out_dir + "/matrix.toml", shards.matrix_text);
+  write_manifest(out_dir + "/cases.csv", entries, shards.selected_cases);
   Provenance own = collect_provenance();
   own.emplace_back("merged_from", std::to_string(shard_dirs.size()) + " shard folders");
-  own.insert(own.end(), merged.begin(), merged.end());
+  own.insert(own.end(), shards.provenance.begin(), shards.provenance.end());
   write_file_atomic(out_dir + "/provenance.txt", format_provenance(own));
   const size_t missing_results = write_matrix_summary(out_dir, entries);
-  const size_t uncovered = selected_cases > entries.size() ? selected_cases - entries.size() : 0;
+  const size_t uncovered = shards.selected_cases > entries.size() ? shards.selected_cases - entries.size() : 0;
   log << "merge: " << entries.size() << " cases from " << shard_dirs.size() << " folders (" << copied
       << " copied) into " << out_dir << "\n";
   if (missing_results) log << "merge: warning: " << missing_results << " cases have no complete result\n";

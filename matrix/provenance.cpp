@@ -12,6 +12,7 @@
 #include <sundials/sundials_config.h>
 #include <thread>
 
+#include "io/hash.hpp"
 #include "matrix/matrix.hpp"
 
 #ifndef CSTAB_SOURCE_ROOT

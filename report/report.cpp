@@ -15,10 +15,14 @@
 #include <set>
 #include <sstream>
 
-#include "io/csv.hpp"
 #include "core/format.hpp"
+#include "io/csv.hpp"
+#include "io/hash.hpp"
+#include "io/number.hpp"
+#include "io/text.hpp"
 #include "matrix/matrix.hpp"
 #include "matrix/provenance.hpp"
+#include "matrix/results.hpp"
 #include "report/stress_report.hpp"
 
 #ifndef CSTAB_SOURCE_ROOT
@@ -33,29 +37,8 @@ namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
-double to_number(const std::string& s) {
-  if (s.empty()) return kNaN;
-  char* end = nullptr;
-  const double v = std::strtod(s.c_str(), &end);
-  return end == s.c_str() ? kNaN : v;
-}
-
-double median(std::vector<double> v) {
-  if (v.empty()) return kNaN;
-  std::sort(v.begin(), v.end());
-  const size_t n = v.size();
-  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
-
-std::string num(double v) { return std::isnan(v) ? std::string() : format_exact(v); }
-
 // Short human form: 3 significant digits.
-std::string sci(double v) {
-  if (std::isnan(v)) return "";
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.3g", v);
-  return buf;
-}
+std::string sci(double v) { return format_3g(v); }
 
 std::string seconds_text(double s) {
   if (std::isnan(s)) return "";
@@ -67,20 +50,6 @@ std::string seconds_text(double s) {
   else
     std::snprintf(buf, sizeof buf, "%.3g s", s);
   return buf;
-}
-
-std::string html(const std::string& s) {
-  std::string out;
-  for (char c : s) {
-    switch (c) {
-      case '&': out += "&amp;"; break;
-      case '<': out += "&lt;"; break;
-      case '>': out += "&gt;"; break;
-      case '"': out += "&quot;"; break;
-      default: out += c;
-    }
-  }
-  return out;
 }
 
 std::string base64(const std::string& data) {
@@ -110,100 +79,11 @@ std::string base64(const std::string& data) {
   return out;
 }
 
-// Gnuplot single-quoted string literal.
-std::string gp_string(const std::string& s) {
-  std::string out = "'";
-  for (char c : s) out += c == '\'' ? std::string("''") : std::string(1, c);
-  return out + "'";
-}
+// A finished case with a timing: a point of the work-precision pictures and tables.
+bool timed(const CaseResult& c) { return c.ok() && std::isfinite(c.wall_median); }
 
-std::string csv_line(const std::vector<std::string>& cells) {
-  std::string line;
-  for (size_t i = 0; i < cells.size(); ++i) {
-    if (i) line += ',';
-    line += csv_field(cells[i]);
-  }
-  return line + "\n";
-}
-
-// A value for a log-scale plot column: "?" (missing) unless finite and > 0.
-std::string log_cell(double v) { return std::isfinite(v) && v > 0 ? format_exact(v) : "?"; }
-
-// ---------------------------------------------------------------------------
-
-struct CaseResult {
-  const CaseEntry* entry = nullptr;
-  bool complete = false;
-  std::string status = "not run", reason, formulation;
-  int ok_repeats = 0;
-  double wall_median = kNaN, wall_min = kNaN, wall_max = kNaN;
-  std::string steps, rhs_evals;
-  double step = kNaN, rtol = kNaN, atol = kNaN;
-  double ref_time = kNaN, ref_error = kNaN, ref_scd = kNaN, max_residual = kNaN, drift = kNaN;
-  std::string drift_name;  // "energy", "first integrals (a, b)", ""
-  bool ok() const { return complete && status == "ok" && std::isfinite(wall_median); }
-  double size() const { return std::isnan(step) ? rtol : step; }  // coarse -> fine ordering
-};
-
-std::vector<CaseResult> load_results(const std::vector<CaseEntry>& entries, const CsvTable& summary) {
-  std::map<std::string, std::vector<size_t>> rows_of;
-  const int id_col = summary.column("case_id");
-  for (size_t r = 0; r < summary.rows.size(); ++r)
-    if (id_col >= 0 && size_t(id_col) < summary.rows[r].size()) rows_of[summary.rows[r][id_col]].push_back(r);
-  std::vector<std::string> integral_cols;
-  for (const auto& h : summary.header)
-    if (h.rfind("max_", 0) == 0 && h.size() > 10 && h.compare(h.size() - 6, 6, "_drift") == 0 &&
-        h != "max_energy_drift")
-      integral_cols.push_back(h);
-
-  std::vector<CaseResult> out;
-  for (const auto& e : entries) {
-    CaseResult c;
-    c.entry = &e;
-    auto it = rows_of.find(e.id);
-    if (it != rows_of.end() && !it->second.empty()) {
-      c.complete = true;
-      const size_t r0 = it->second.front();
-      auto get = [&](const char* col) -> const std::string& { return summary.get(r0, col); };
-      c.status = get("status");
-      c.reason = get("reason");
-      c.formulation = get("formulation");
-      c.steps = get("steps");
-      c.rhs_evals = get("rhs_evals");
-      c.step = to_number(get("step"));
-      c.rtol = to_number(get("rtol"));
-      c.atol = to_number(get("atol"));
-      c.ref_time = to_number(get("ref_time"));
-      c.ref_error = to_number(get("ref_error"));
-      c.ref_scd = to_number(get("ref_scd"));
-      c.max_residual = to_number(get("max_residual"));
-      if (get("energy_law") == "yes") {
-        c.drift = to_number(get("max_energy_drift"));
-        c.drift_name = "energy";
-      } else {
-        std::string names;
-        for (const auto& col : integral_cols) {
-          const double v = to_number(summary.get(r0, col));
-          if (std::isnan(v)) continue;
-          c.drift = std::isnan(c.drift) ? v : std::max(c.drift, v);
-          names += (names.empty() ? "" : ", ") + col.substr(4, col.size() - 10);
-        }
-        if (!names.empty()) c.drift_name = "first integrals (" + names + ")";
-      }
-      std::vector<double> walls;
-      for (size_t r : it->second)
-        if (summary.get(r, "status") == "ok") walls.push_back(to_number(summary.get(r, "wall_seconds")));
-      c.ok_repeats = int(walls.size());
-      if (!walls.empty()) {
-        c.wall_median = median(walls);
-        c.wall_min = *std::min_element(walls.begin(), walls.end());
-        c.wall_max = *std::max_element(walls.begin(), walls.end());
-      }
-    }
-    out.push_back(std::move(c));
-  }
-  return out;
-}
+// Step size, else relative tolerance: coarse -> fine ordering.
+double case_size(const CaseResult& c) { return std::isnan(c.step) ? c.rtol : c.step; }
 
 // ---------------------------------------------------------------------------
 
@@ -223,7 +103,7 @@ std::vector<const CaseResult*> rank_at(const std::vector<const CaseResult*>& cas
   std::map<std::string, const CaseResult*> best;
   for (const CaseResult* c : cases) {
     const double v = c->*(m.value);
-    if (!c->ok() || !(v <= level)) continue;
+    if (!timed(*c) || !(v <= level)) continue;
     auto& slot = best[c->entry->curve];
     if (!slot || c->wall_median < slot->wall_median) slot = c;
   }
@@ -273,10 +153,10 @@ std::vector<const CaseResult*> overlay_runs(const std::string& dir, const Proble
   for (const auto& m : p.methods) {
     const CaseResult* pick = nullptr;
     for (const CaseResult* c : p.cases)
-      if (!pick && c->entry->method == m && c->entry->overlay && c->ok() && has_series(dir, c)) pick = c;
+      if (!pick && c->entry->method == m && c->entry->overlay && timed(*c) && has_series(dir, c)) pick = c;
     if (!pick)
       for (const CaseResult* c : p.cases) {
-        if (c->entry->method != m || !c->ok() || !has_series(dir, c)) continue;
+        if (c->entry->method != m || !timed(*c) || !has_series(dir, c)) continue;
         if (!pick || c->entry->t_end > pick->entry->t_end ||
             (c->entry->t_end == pick->entry->t_end && (std::isnan(pick->ref_error) || c->ref_error < pick->ref_error)))
           pick = c;
@@ -298,7 +178,7 @@ std::vector<const CaseResult*> trajectory_runs(const std::string& dir, const Pro
   for (const auto& m : p.methods) {
     const CaseResult* pick = nullptr;
     for (const CaseResult* c : p.cases)
-      if (c->entry->method == m && c->ok() && std::isfinite(c->ref_error) && has_series(dir, c) &&
+      if (c->entry->method == m && timed(*c) && std::isfinite(c->ref_error) && has_series(dir, c) &&
           (!pick || c->ref_error < pick->ref_error))
         pick = c;
     if (!pick)
@@ -312,14 +192,12 @@ std::vector<const CaseResult*> trajectory_runs(const std::string& dir, const Pro
 std::string run_label(const CaseResult& c) {
   std::string s = c.entry->method + "/" + c.entry->integrator + " " + c.entry->setting;
   if (!c.entry->params.empty()) s += " " + c.entry->params;
-  if (c.status != "ok") s += " (" + c.status + ")";
+  if (c.status != Status::kOk) s += std::string(" (") + status_name(c.status) + ")";
   return s;
 }
 
 std::string quoted_header(const std::string& label, const std::vector<std::string>& rest) {
-  std::string h = "\"";
-  for (char ch : label) h += ch == '"' ? '\'' : ch;
-  h += "\"";
+  std::string h = gnuplot_data_title(label);
   for (const auto& r : rest) h += " " + r;
   return h + "\n";
 }
@@ -353,17 +231,11 @@ SeriesColumns classify(const CsvTable& s) {
 }
 
 double cell(const std::vector<std::string>& row, int col) {
-  return size_t(col) < row.size() ? to_number(row[col]) : kNaN;
+  return size_t(col) < row.size() ? parse_number(row[col]) : kNaN;
 }
 
 // A case's series.csv; empty if it is missing or unreadable.
-CsvTable read_series(const std::string& dir, const CaseResult& c) {
-  try {
-    return read_csv(dir + "/cases/" + c.entry->id + "/series.csv");
-  } catch (const std::exception&) {
-    return {};
-  }
-}
+CsvTable read_series(const std::string& dir, const CaseResult& c) { return load_case_series(dir, *c.entry); }
 
 // Overlay data: per run, t, max |residual|, |drift|. Colours in `lcs`.
 std::string overlay_data(const std::string& dir, const std::vector<const CaseResult*>& runs,
@@ -382,7 +254,7 @@ std::string overlay_data(const std::string& dir, const std::vector<const CaseRes
       double res = cols.residuals.empty() ? kNaN : 0.0, drift = cols.drifts.empty() ? kNaN : 0.0;
       for (int col : cols.residuals) res = std::max(res, std::abs(cell(row, col)));
       for (int col : cols.drifts) drift = std::max(drift, std::abs(cell(row, col)));
-      out += row[0] + " " + log_cell(res) + " " + log_cell(drift) + "\n";
+      out += row[0] + " " + log_plot_cell(res) + " " + log_plot_cell(drift) + "\n";
     }
   }
   return out;
@@ -521,20 +393,24 @@ std::string find_plot_scripts() {
   return "";
 }
 
-ReportResult build_report(const std::string& dir, const ReportOptions& opt, std::ostream& log) {
-  ReportResult result;
-  const std::vector<CaseEntry> entries = read_results_manifest(dir);
-  CsvTable summary;
-  try {
-    summary = read_csv(dir + "/summary.csv");
-  } catch (const std::exception&) {
-    write_matrix_summary(dir, entries);
-    summary = read_csv(dir + "/summary.csv");
-  }
-  const std::vector<CaseResult> results = load_results(entries, summary);
 
-  // ---- per problem ----
+namespace {
+
+// ---- stages of build_report ----
+
+// The folder parsed once; DIR/summary.csv written first if it is missing.
+ResultsFolder load_report_input(const std::string& dir) {
+  ResultsFolder folder = load_results_folder(dir);
+  if (!fs::exists(dir + "/summary.csv")) write_matrix_summary(dir, folder.entries);
+  return folder;
+}
+
+// Cases grouped by problem (first-appearance order), with the curves, methods and integrators of each.
+std::vector<ProblemView> group_by_problem(const std::vector<CaseResult>& results) {
   std::vector<ProblemView> problems;
+  auto add_once = [](std::vector<std::string>& list, const std::string& s) {
+    if (std::find(list.begin(), list.end(), s) == list.end()) list.push_back(s);
+  };
   for (const CaseResult& c : results) {
     auto it = std::find_if(problems.begin(), problems.end(), [&](const ProblemView& p) { return p.name == c.entry->problem; });
     if (it == problems.end()) {
@@ -543,294 +419,386 @@ ReportResult build_report(const std::string& dir, const ReportOptions& opt, std:
       it = problems.end() - 1;
     }
     it->cases.push_back(&c);
-    if (std::find(it->methods.begin(), it->methods.end(), c.entry->method) == it->methods.end())
-      it->methods.push_back(c.entry->method);
-    if (std::find(it->integrators.begin(), it->integrators.end(), c.entry->integrator) == it->integrators.end())
-      it->integrators.push_back(c.entry->integrator);
+    add_once(it->methods, c.entry->method);
+    add_once(it->integrators, c.entry->integrator);
     if (c.entry->work_precision) {
       it->wp.push_back(&c);
-      if (std::find(it->curves.begin(), it->curves.end(), c.entry->curve) == it->curves.end())
-        it->curves.push_back(c.entry->curve);
+      add_once(it->curves, c.entry->curve);
     }
     if (it->drift_name.empty()) it->drift_name = c.drift_name;
-    if (std::isnan(it->ref_time) && c.ok()) it->ref_time = c.ref_time;
+    if (std::isnan(it->ref_time) && timed(c)) it->ref_time = c.ref_time;
   }
+  return problems;
+}
 
-  // ---- work_precision.csv and fastest.csv ----
-  {
-    std::string csv =
-        "problem,curve,method,formulation,integrator,params,setting,step,rtol,atol,t_end,case_id,sweep,repeats,"
-        "status,wall_median_s,wall_min_s,wall_max_s,steps,rhs_evals,ref_time,ref_error,ref_scd,max_residual,"
-        "drift_quantity,max_drift\n";
-    for (const auto& p : problems)
-      for (const CaseResult* c : p.wp) {
-        const CaseEntry& e = *c->entry;
-        const std::vector<std::string> cells = {
-            e.problem, e.curve, e.method, c->formulation, e.integrator, e.params, e.setting, num(c->step),
-            num(c->rtol), num(c->atol), format_short(e.t_end), e.id, e.sweep, std::to_string(e.repeats), c->status,
-            num(c->wall_median), num(c->wall_min), num(c->wall_max), c->steps, c->rhs_evals, num(c->ref_time),
-            num(c->ref_error), num(c->ref_scd), num(c->max_residual), c->drift_name, num(c->drift)};
-        csv += csv_line(cells);
-      }
-    write_file_atomic(dir + "/work_precision.csv", csv);
+// DIR/work_precision.csv: one row per work-precision case.
+void write_work_precision_csv(const std::string& dir, const std::vector<ProblemView>& problems) {
+  std::string csv =
+      "problem,curve,method,formulation,integrator,params,setting,step,rtol,atol,t_end,case_id,sweep,repeats,"
+      "status,wall_median_s,wall_min_s,wall_max_s,steps,rhs_evals,ref_time,ref_error,ref_scd,max_residual,"
+      "drift_quantity,max_drift\n";
+  for (const auto& p : problems)
+    for (const CaseResult* c : p.wp) {
+      const CaseEntry& e = *c->entry;
+      csv += csv_line({e.problem, e.curve, e.method, c->formulation, e.integrator, e.params, e.setting,
+                       number_cell(c->step), number_cell(c->rtol), number_cell(c->atol), format_short(e.t_end), e.id,
+                       e.sweep, std::to_string(e.repeats), status_name(c->status), number_cell(c->wall_median),
+                       number_cell(c->wall_min), number_cell(c->wall_max), count_cell(c->steps),
+                       count_cell(c->rhs_evals), number_cell(c->ref_time), number_cell(c->ref_error),
+                       number_cell(c->ref_scd), number_cell(c->max_residual), c->drift_name, number_cell(c->drift)});
+    }
+  write_file_atomic(dir + "/work_precision.csv", csv);
+}
 
-    std::string fast =
-        "problem,measure,threshold,rank,curve,method,integrator,case_id,setting,wall_median_s,value,"
-        "ratio_to_fastest\n";
-    for (const auto& p : problems)
-      for (const Measure& m : kMeasures)
-        for (double level : accuracy_levels()) {
-          const auto ranked = rank_at(p.wp, m, level);
-          for (size_t r = 0; r < ranked.size(); ++r) {
-            const CaseResult& c = *ranked[r];
-            const std::vector<std::string> cells = {
-                p.name, m.key, format_short(level), std::to_string(r + 1), c.entry->curve, c.entry->method,
-                c.entry->integrator, c.entry->id, case_setting(c), num(c.wall_median), num(c.*(m.value)),
-                num(c.wall_median / ranked[0]->wall_median)};
-            fast += csv_line(cells);
-          }
+// DIR/fastest.csv: per problem, measure and level, the curves reaching it, fastest first.
+void write_fastest_csv(const std::string& dir, const std::vector<ProblemView>& problems) {
+  std::string fast =
+      "problem,measure,threshold,rank,curve,method,integrator,case_id,setting,wall_median_s,value,"
+      "ratio_to_fastest\n";
+  for (const auto& p : problems)
+    for (const Measure& m : kMeasures)
+      for (double level : accuracy_levels()) {
+        const auto ranked = rank_at(p.wp, m, level);
+        for (size_t r = 0; r < ranked.size(); ++r) {
+          const CaseResult& c = *ranked[r];
+          fast += csv_line({p.name, m.key, format_short(level), std::to_string(r + 1), c.entry->curve,
+                            c.entry->method, c.entry->integrator, c.entry->id, case_setting(c),
+                            number_cell(c.wall_median), number_cell(c.*(m.value)),
+                            number_cell(c.wall_median / ranked[0]->wall_median)});
         }
-    write_file_atomic(dir + "/fastest.csv", fast);
-  }
+      }
+  write_file_atomic(dir + "/fastest.csv", fast);
+}
 
-  // ---- plot data and gnuplot ----
-  const std::string plot_dir = dir + "/plots";
-  std::error_code ec;
-  fs::create_directories(plot_dir + "/data", ec);
+// The pictures to draw: data files written as jobs are added.
+struct PlotSet {
+  std::string plot_dir;
   std::vector<PlotJob> jobs;
   std::map<std::string, std::string> captions;
-  for (auto& p : problems) {
-    // Colour = method, point type and dash = integrator, the same in every picture of the problem.
-    std::map<std::string, int> colour;
+  // Writes plots/data/<name>.dat and queues the job; returns the name.
+  std::string add(const std::string& name, const std::string& script, const std::string& data,
+                  const std::string& extra_vars, const std::string& caption) {
+    const std::string data_path = plot_dir + "/data/" + name + ".dat";
+    write_file_atomic(data_path, data);
+    jobs.push_back({name, script,
+                    "data=" + gnuplot_string(data_path) + "; out=" + gnuplot_string(plot_dir + "/" + name) + extra_vars,
+                    data, caption});
+    captions[name] = caption;
+    return name;
+  }
+};
+
+// Colour = method, point type and dash = integrator, the same in every picture of a problem.
+struct ProblemStyle {
+  const ProblemView& p;
+  std::map<std::string, int> colour;
+  explicit ProblemStyle(const ProblemView& view) : p(view) {
     for (size_t i = 0; i < p.methods.size(); ++i) colour[p.methods[i]] = int(i % 12) + 1;
-    auto integrator_style = [&](const std::string& name) {
-      static const int points[] = {7, 5, 9, 11, 13, 15, 4, 6, 8, 10};
-      const size_t j = size_t(std::find(p.integrators.begin(), p.integrators.end(), name) - p.integrators.begin());
-      return std::make_pair(points[j % 10], int(j % 5) + 1);
-    };
-    const std::string drift_label =
-        p.drift_name == "energy" ? "max |E(t) - E(0)|"
-                                 : (p.drift_name.empty() ? "max drift (no energy law or first integral)"
-                                                         : "max drift of " + p.drift_name);
-    const std::string ref_label = std::isnan(p.ref_time) ? "the reference time" : "t = " + format_short(p.ref_time);
-    // Work-precision data: one block per curve, coarse to fine.
-    std::string wp, lcs, pts, dts;
-    size_t blocks = 0;
-    bool has_ref = false, has_drift_values = false;
-    for (const auto& curve : p.curves) {
-      std::vector<const CaseResult*> pts_of;
-      for (const CaseResult* c : p.wp)
-        if (c->entry->curve == curve && c->ok()) pts_of.push_back(c);
-      if (pts_of.empty()) continue;
-      std::stable_sort(pts_of.begin(), pts_of.end(), [](const CaseResult* a, const CaseResult* b) {
-        return a->entry->t_end != b->entry->t_end ? a->entry->t_end < b->entry->t_end : a->size() > b->size();
-      });
-      if (blocks++) wp += "\n\n";
-      wp += quoted_header(curve, {"wall_median_s", "ref_error", "ref_scd", "max_residual", "max_drift", "setting"});
-      const auto [point, dash] = integrator_style(pts_of[0]->entry->integrator);
-      lcs += " " + std::to_string(colour[pts_of[0]->entry->method]);
-      pts += " " + std::to_string(point);
-      dts += " " + std::to_string(dash);
-      for (const CaseResult* c : pts_of) {
-        has_ref = has_ref || (std::isfinite(c->ref_error) && c->ref_error > 0);
-        has_drift_values = has_drift_values || (std::isfinite(c->drift) && c->drift > 0);
-      }
-      for (const CaseResult* c : pts_of)
-        wp += format_exact(c->wall_median) + " " + log_cell(c->ref_error) + " " +
-              (std::isfinite(c->ref_scd) ? format_exact(c->ref_scd) : "?") + " " + log_cell(c->max_residual) + " " +
-              log_cell(c->drift) + " " + format_exact(c->size()) + "\n";
+  }
+  std::pair<int, int> integrator(const std::string& name) const {
+    static const int points[] = {7, 5, 9, 11, 13, 15, 4, 6, 8, 10};
+    const size_t j = size_t(std::find(p.integrators.begin(), p.integrators.end(), name) - p.integrators.begin());
+    return {points[j % 10], int(j % 5) + 1};
+  }
+};
+
+// Work-precision data: one block per curve, coarse to fine, with its styles.
+struct WorkPrecisionData {
+  std::string text, lcs, pts, dts;
+  size_t blocks = 0;
+  bool has_ref = false, has_drift = false;
+};
+WorkPrecisionData work_precision_data(const ProblemView& p, const ProblemStyle& style) {
+  WorkPrecisionData d;
+  for (const auto& curve : p.curves) {
+    std::vector<const CaseResult*> pts_of;
+    for (const CaseResult* c : p.wp)
+      if (c->entry->curve == curve && timed(*c)) pts_of.push_back(c);
+    if (pts_of.empty()) continue;
+    std::stable_sort(pts_of.begin(), pts_of.end(), [](const CaseResult* a, const CaseResult* b) {
+      return a->entry->t_end != b->entry->t_end ? a->entry->t_end < b->entry->t_end : case_size(*a) > case_size(*b);
+    });
+    if (d.blocks++) d.text += "\n\n";
+    d.text += quoted_header(curve, {"wall_median_s", "ref_error", "ref_scd", "max_residual", "max_drift", "setting"});
+    const auto [point, dash] = style.integrator(pts_of[0]->entry->integrator);
+    d.lcs += " " + std::to_string(style.colour.at(pts_of[0]->entry->method));
+    d.pts += " " + std::to_string(point);
+    d.dts += " " + std::to_string(dash);
+    for (const CaseResult* c : pts_of) {
+      d.has_ref = d.has_ref || (std::isfinite(c->ref_error) && c->ref_error > 0);
+      d.has_drift = d.has_drift || (std::isfinite(c->drift) && c->drift > 0);
     }
-    const std::string base = plot_dir + "/data/";
-    auto add_job = [&](const std::string& kind, const std::string& script, const std::string& data,
-                       const std::string& extra_vars, const std::string& caption) {
-      const std::string name = p.name + "_" + kind;
-      const std::string data_path = base + name + ".dat";
-      write_file_atomic(data_path, data);
-      const std::string vars = "data=" + gp_string(data_path) + "; out=" + gp_string(plot_dir + "/" + name) +
-                               "; problem=" + gp_string(p.name) + extra_vars;
-      jobs.push_back({name, script, vars, data, caption});
-      p.plots.push_back(name);
-      captions[name] = caption;
-    };
-    if (blocks)
-      add_job("work_precision", "work_precision.gp", wp,
-              "; has_ref=" + std::string(has_ref ? "1" : "0") + "; has_drift=" + (has_drift_values ? "1" : "0") +
-                  "; drift_label=" + gp_string(drift_label) + "; ref_label=" + gp_string(ref_label) + "; lcs=" +
-                  gp_string(lcs) + "; pts=" + gp_string(pts) + "; dts=" + gp_string(dts),
-              "Work-precision of " + p.name + ": error against wall time (median of repeats), log-log, one curve "
-              "per method/integrator (colour = method, point and dash = integrator); points from coarse to fine "
-              "step size or tolerance. Top left: max |y - y_ref| at " + ref_label + "; top right: significant "
-              "correct digits; bottom: largest constraint residual and largest " +
-                  (p.drift_name.empty() ? std::string("drift") : p.drift_name + " drift") +
-                  " over the run. Diverged and failed runs are left out.");
+    for (const CaseResult* c : pts_of)
+      d.text += format_exact(c->wall_median) + " " + log_plot_cell(c->ref_error) + " " +
+                (std::isfinite(c->ref_scd) ? format_exact(c->ref_scd) : "?") + " " + log_plot_cell(c->max_residual) +
+                " " + log_plot_cell(c->drift) + " " + format_exact(case_size(*c)) + "\n";
+  }
+  return d;
+}
+
+// <problem>_work_precision: error against wall time, one curve per method/integrator.
+void add_work_precision_plot(PlotSet& plots, ProblemView& p, const ProblemStyle& style) {
+  const WorkPrecisionData d = work_precision_data(p, style);
+  if (!d.blocks) return;
+  const std::string drift_label =
+      p.drift_name == "energy" ? "max |E(t) - E(0)|"
+                               : (p.drift_name.empty() ? "max drift (no energy law or first integral)"
+                                                       : "max drift of " + p.drift_name);
+  const std::string ref_label = std::isnan(p.ref_time) ? "the reference time" : "t = " + format_short(p.ref_time);
+  p.plots.push_back(plots.add(
+      p.name + "_work_precision", "work_precision.gp", d.text,
+      "; problem=" + gnuplot_string(p.name) + "; has_ref=" + std::string(d.has_ref ? "1" : "0") +
+          "; has_drift=" + (d.has_drift ? "1" : "0") + "; drift_label=" + gnuplot_string(drift_label) +
+          "; ref_label=" + gnuplot_string(ref_label) + "; lcs=" + gnuplot_string(d.lcs) +
+          "; pts=" + gnuplot_string(d.pts) + "; dts=" + gnuplot_string(d.dts),
+      "Work-precision of " + p.name + ": error against wall time (median of repeats), log-log, one curve "
+      "per method/integrator (colour = method, point and dash = integrator); points from coarse to fine "
+      "step size or tolerance. Top left: max |y - y_ref| at " + ref_label + "; top right: significant "
+      "correct digits; bottom: largest constraint residual and largest " +
+          (p.drift_name.empty() ? std::string("drift") : p.drift_name + " drift") +
+          " over the run. Diverged and failed runs are left out."));
+}
+
+// <problem>_overlay: residual and drift against time, one run per method.
+void add_overlay_plot(PlotSet& plots, const std::string& dir, ProblemView& p, const ProblemStyle& style,
+                      const std::vector<const CaseResult*>& overlay) {
+  std::string lcs;
+  bool has_drift = false;
+  const std::string text = overlay_data(dir, overlay, style.colour, lcs, has_drift);
+  if (text.empty()) return;
+  std::string who;
+  for (const CaseResult* c : overlay) who += (who.empty() ? "" : "; ") + run_label(*c);
+  p.plots.push_back(plots.add(
+      p.name + "_overlay", "overlay.gp", text,
+      "; problem=" + gnuplot_string(p.name) + "; has_drift=" + std::string(has_drift ? "1" : "0") +
+          "; lcs=" + gnuplot_string(lcs) + "; drift_label=" +
+          gnuplot_string(p.drift_name == "energy" ? "|E(t) - E(0)|" : "|drift of " + p.drift_name + "|"),
+      "Constraint residual (largest over the constraints) and " +
+          (p.drift_name.empty() ? std::string("conserved-quantity") : p.drift_name) + " drift against time for " +
+          p.name + ", one run per method: " + who + "."));
+}
+
+// <problem>_trajectory: position coordinates against time, per method its most accurate run.
+void add_trajectory_plot(PlotSet& plots, const std::string& dir, ProblemView& p, const ProblemStyle& style,
+                         const std::vector<const CaseResult*>& overlay) {
+  std::string lcs;
+  std::vector<std::string> names;
+  const auto trajectory = trajectory_runs(dir, p, overlay);
+  const std::string text = trajectory_data(dir, trajectory, style.colour, lcs, names);
+  if (text.empty()) return;
+  std::string joined, who;
+  for (const auto& n : names) joined += (joined.empty() ? "" : " ") + n;
+  for (const CaseResult* c : trajectory) who += (who.empty() ? "" : "; ") + run_label(*c);
+  p.plots.push_back(plots.add(
+      p.name + "_trajectory", "trajectory.gp", text,
+      "; problem=" + gnuplot_string(p.name) + "; names=" + gnuplot_string(joined) + "; lcs=" + gnuplot_string(lcs),
+      "Trajectories of " + p.name + ": position coordinates against time, per method its most accurate "
+      "run against the reference: " + who + "."));
+}
+
+// Every picture of every problem (its data files written).
+void plan_problem_plots(PlotSet& plots, const std::string& dir, std::vector<ProblemView>& problems) {
+  for (auto& p : problems) {
+    const ProblemStyle style(p);
+    add_work_precision_plot(plots, p, style);
     const auto overlay = overlay_runs(dir, p);
-    std::string overlay_lcs, trajectory_lcs;
-    bool has_drift = false;
-    const std::string overlay_text = overlay_data(dir, overlay, colour, overlay_lcs, has_drift);
-    if (!overlay_text.empty()) {
-      std::string who;
-      for (const CaseResult* c : overlay) who += (who.empty() ? "" : "; ") + run_label(*c);
-      add_job("overlay", "overlay.gp", overlay_text,
-              "; has_drift=" + std::string(has_drift ? "1" : "0") + "; lcs=" + gp_string(overlay_lcs) +
-                  "; drift_label=" +
-                  gp_string(p.drift_name == "energy" ? "|E(t) - E(0)|" : "|drift of " + p.drift_name + "|"),
-              "Constraint residual (largest over the constraints) and " +
-                  (p.drift_name.empty() ? std::string("conserved-quantity") : p.drift_name) +
-                  " drift against time for " + p.name + ", one run per method: " + who + ".");
-    }
-    std::vector<std::string> names;
-    const auto trajectory = trajectory_runs(dir, p, overlay);
-    const std::string trajectory_text = trajectory_data(dir, trajectory, colour, trajectory_lcs, names);
-    if (!trajectory_text.empty()) {
-      std::string joined, who;
-      for (const auto& n : names) joined += (joined.empty() ? "" : " ") + n;
-      for (const CaseResult* c : trajectory) who += (who.empty() ? "" : "; ") + run_label(*c);
-      add_job("trajectory", "trajectory.gp", trajectory_text,
-              "; names=" + gp_string(joined) + "; lcs=" + gp_string(trajectory_lcs),
-              "Trajectories of " + p.name + ": position coordinates against time, per method its most accurate "
-              "run against the reference: " + who + ".");
-    }
+    add_overlay_plot(plots, dir, p, style, overlay);
+    add_trajectory_plot(plots, dir, p, style, overlay);
   }
+}
 
-  // The Stress section (stress_report.hpp): its tables and pictures.
-  const StressSection stress = build_stress_section(dir, entries, summary);
-  std::vector<std::string> stress_plots;
-  for (const StressPlot& sp : stress.plots) {
-    const std::string data_path = plot_dir + "/data/" + sp.name + ".dat";
-    write_file_atomic(data_path, sp.data);
-    jobs.push_back({sp.name, sp.script, "data=" + gp_string(data_path) + "; out=" + gp_string(plot_dir + "/" + sp.name) + sp.vars,
-                    sp.data, sp.caption});
-    captions[sp.name] = sp.caption;
-    stress_plots.push_back(sp.name);
-  }
+// The Stress section's pictures (stress_report.hpp); their names in order.
+std::vector<std::string> plan_stress_plots(PlotSet& plots, const StressSection& stress) {
+  std::vector<std::string> names;
+  for (const StressPlot& sp : stress.plots) names.push_back(plots.add(sp.name, sp.script, sp.data, sp.vars, sp.caption));
+  return names;
+}
 
-  // replot.sh: the exact commands, for editing a picture by hand.
-  const std::string scripts = opt.plot_scripts.empty() ? find_plot_scripts() : opt.plot_scripts;
-  {
-    std::string sh = "#!/bin/sh\n# Redraws the pictures of this results folder (written by cstab report).\nset -e\n";
-    sh += "PLOTS=${CSTAB_PLOTS:-" + (scripts.empty() ? std::string("plots") : scripts) + "}\n";
-    for (const auto& j : jobs) {
-      std::string q;
-      for (char c : j.vars) q += c == '"' ? std::string("\\\"") : std::string(1, c);
-      sh += "gnuplot -e \"" + q + "\" \"$PLOTS/" + j.script + "\"\n";
-    }
-    write_file_atomic(plot_dir + "/replot.sh", sh);
+// plots/replot.sh: the exact commands, for editing a picture by hand.
+void write_replot_script(const PlotSet& plots, const std::string& scripts) {
+  std::string sh = "#!/bin/sh\n# Redraws the pictures of this results folder (written by cstab report).\nset -e\n";
+  sh += "PLOTS=${CSTAB_PLOTS:-" + (scripts.empty() ? std::string("plots") : scripts) + "}\n";
+  for (const auto& j : plots.jobs) {
+    std::string q;
+    for (char c : j.vars) q += c == '"' ? std::string("\\\"") : std::string(1, c);
+    sh += "gnuplot -e \"" + q + "\" \"$PLOTS/" + j.script + "\"\n";
   }
-  if (opt.plots) {
-    if (scripts.empty()) {
-      result.warnings.push_back("gnuplot scripts not found (set CSTAB_PLOTS to the plots/ folder): no pictures");
-    } else {
-      const std::string style = file_or_empty(scripts + "/style.gp");
-      std::vector<PlotJob> todo;
-      for (const auto& j : jobs) {
-        const std::string stamp =
-            hash_hex(file_or_empty(scripts + "/" + j.script) + style + j.vars + j.data) + "\n";
-        const std::string stamp_path = plot_dir + "/data/" + j.name + ".stamp";
-        if (file_or_empty(stamp_path) == stamp && fs::exists(plot_dir + "/" + j.name + ".png") &&
-            fs::exists(plot_dir + "/" + j.name + ".svg")) {
-          ++result.plots_reused;
-          continue;
-        }
-        fs::remove(stamp_path, ec);
-        todo.push_back(j);
-      }
-      std::set<std::string> drawn;
-      for (const auto& f : run_gnuplot(todo, scripts, plot_dir, opt.jobs, drawn)) result.warnings.push_back(f);
-      for (const auto& j : todo) {
-        if (!drawn.count(j.name)) continue;
-        ++result.plots_drawn;
-        write_file_atomic(plot_dir + "/data/" + j.name + ".stamp",
-                          hash_hex(file_or_empty(scripts + "/" + j.script) + style + j.vars + j.data) + "\n");
-      }
-    }
-  }
+  write_file_atomic(plots.plot_dir + "/replot.sh", sh);
+}
 
-  // ---- report.html ----
+// Runs gnuplot for every picture whose stamp (script, style, variables, data) changed.
+void draw_plots(const PlotSet& plots, const std::string& scripts, int jobs, ReportResult& result) {
+  if (scripts.empty()) {
+    result.warnings.push_back("gnuplot scripts not found (set CSTAB_PLOTS to the plots/ folder): no pictures");
+    return;
+  }
+  const std::string& plot_dir = plots.plot_dir;
+  const std::string style = file_or_empty(scripts + "/style.gp");
+  auto stamp_of = [&](const PlotJob& j) {
+    return hash_hex(file_or_empty(scripts + "/" + j.script) + style + j.vars + j.data) + "\n";
+  };
+  std::vector<PlotJob> todo;
+  std::error_code ec;
+  for (const auto& j : plots.jobs) {
+    const std::string stamp_path = plot_dir + "/data/" + j.name + ".stamp";
+    if (file_or_empty(stamp_path) == stamp_of(j) && fs::exists(plot_dir + "/" + j.name + ".png") &&
+        fs::exists(plot_dir + "/" + j.name + ".svg")) {
+      ++result.plots_reused;
+      continue;
+    }
+    fs::remove(stamp_path, ec);
+    todo.push_back(j);
+  }
+  std::set<std::string> drawn;
+  for (const auto& f : run_gnuplot(todo, scripts, plot_dir, jobs, drawn)) result.warnings.push_back(f);
+  for (const auto& j : todo) {
+    if (!drawn.count(j.name)) continue;
+    ++result.plots_drawn;
+    write_file_atomic(plot_dir + "/data/" + j.name + ".stamp", stamp_of(j));
+  }
+}
+
+// ---- report.html, section by section ----
+
+// What the page is built from.
+struct Page {
+  const std::string& dir;
+  const std::vector<CaseResult>& results;
+  const std::vector<ProblemView>& problems;
+  const StressSection& stress;
+  const std::vector<std::string>& stress_plots;
+  const PlotSet& plots;
+  const Provenance& prov;
+  const std::vector<std::string>& warnings;
+};
+
+// Head, title line with the status counts, navigation.
+void html_head(std::ostream& h, const Page& pg) {
   size_t n_ok = 0, n_div = 0, n_fail = 0, n_missing = 0, n_na = 0;
-  for (const auto& c : results) {
-    if (!c.complete)
-      ++n_missing;
-    else if (c.status == "ok")
-      ++n_ok;
-    else if (c.status == "diverged")
-      ++n_div;
-    else if (c.status == "invalid")
-      ++n_na;
-    else
-      ++n_fail;
+  for (const auto& c : pg.results) {
+    switch (c.status) {
+      case Status::kNotRun: ++n_missing; break;
+      case Status::kOk: ++n_ok; break;
+      case Status::kDiverged: ++n_div; break;
+      case Status::kInvalid: ++n_na; break;
+      default: ++n_fail;
+    }
   }
-  const Provenance prov = parse_provenance(file_or_empty(dir + "/provenance.txt"));
   std::string date;
-  for (const auto& [k, v] : prov)
+  for (const auto& [k, v] : pg.prov)
     if (k == "date" && date.empty()) date = v;
-
-  std::ostringstream h;
-  h << "<!doctype html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">\n<title>cstab report: " << html(dir)
+  h << "<!doctype html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">\n<title>cstab report: " << html_escape(pg.dir)
     << "</title>\n<style>" << kStyle << "</style>\n</head><body>\n";
-  h << "<h1>cstab benchmark report</h1>\n<p class=\"meta\">Results folder <code>" << html(dir) << "</code>"
-    << (date.empty() ? "" : ", matrix run " + html(date)) << ". " << results.size() << " cases: " << n_ok << " ok, "
-    << n_div << " diverged, " << n_fail << " failed, " << n_na << " not applicable"
+  h << "<h1>cstab benchmark report</h1>\n<p class=\"meta\">Results folder <code>" << html_escape(pg.dir) << "</code>"
+    << (date.empty() ? "" : ", matrix run " + html_escape(date)) << ". " << pg.results.size() << " cases: " << n_ok
+    << " ok, " << n_div << " diverged, " << n_fail << " failed, " << n_na << " not applicable"
     << (n_missing ? ", " + std::to_string(n_missing) + " not run" : "")
     << ". Wall times are integration only (observation excluded), median over the repeats.</p>\n";
   h << "<nav>";
-  for (const auto& p : problems) h << "<a href=\"#problem-" << html(p.name) << "\">" << html(p.name) << "</a>";
-  if (!stress.empty) h << "<a href=\"#stress\">stress</a>";
+  for (const auto& p : pg.problems)
+    h << "<a href=\"#problem-" << html_escape(p.name) << "\">" << html_escape(p.name) << "</a>";
+  if (!pg.stress.empty) h << "<a href=\"#stress\">stress</a>";
   h << "<a href=\"#cases\">all cases</a><a href=\"#provenance\">provenance</a></nav>\n";
+}
 
-  // Overview.
+// One overview cell: the fastest curve to ref error <= level and the next method's factor.
+void html_fastest_cell(std::ostream& h, const ProblemView& p, double level) {
+  const auto ranked = rank_at(p.wp, kMeasures[0], level);
+  if (ranked.empty()) {
+    h << "<td>none reaches it</td>";
+    return;
+  }
+  h << "<td><span class=\"win\">" << html_escape(ranked[0]->entry->curve) << "</span> "
+    << seconds_text(ranked[0]->wall_median);
+  for (const CaseResult* r : ranked)
+    if (r->entry->method != ranked[0]->entry->method) {
+      h << "; " << html_escape(r->entry->method) << " " << sci(r->wall_median / ranked[0]->wall_median)
+        << "&times; slower";
+      break;
+    }
+  h << "</td>";
+}
+
+// "Matrix summary": one row per problem.
+void html_overview(std::ostream& h, const Page& pg) {
   h << "<h2 id=\"overview\">Matrix summary</h2>\n<table><tr><th>problem</th><th>methods</th><th>integrators</th>"
        "<th>cases</th><th>ok</th><th>diverged</th><th>failed / not run</th><th>n/a</th>";
-  for (double level : {1e-6, 1e-10})
-    h << "<th>fastest to error &le; " << sci(level) << " (vs. next method)</th>";
+  for (double level : {1e-6, 1e-10}) h << "<th>fastest to error &le; " << sci(level) << " (vs. next method)</th>";
   h << "</tr>\n";
-  for (const auto& p : problems) {
+  auto joined = [](const std::set<std::string>& s) {
+    std::string out;
+    for (const auto& x : s) out += (out.empty() ? "" : ", ") + x;
+    return out;
+  };
+  for (const auto& p : pg.problems) {
     std::set<std::string> methods, integrators;
     size_t ok = 0, div = 0, bad = 0, na = 0;
     for (const CaseResult* c : p.cases) {
-      if (c->complete && c->status == "invalid") {
+      if (c->status == Status::kInvalid) {
         ++na;
         continue;
       }
       methods.insert(c->entry->method);
       integrators.insert(c->entry->integrator);
-      if (!c->complete || (c->status != "ok" && c->status != "diverged"))
-        ++bad;
-      else if (c->status == "ok")
+      if (c->status == Status::kOk)
         ++ok;
-      else
+      else if (c->status == Status::kDiverged)
         ++div;
+      else
+        ++bad;
     }
-    auto joined = [](const std::set<std::string>& s) {
-      std::string out;
-      for (const auto& x : s) out += (out.empty() ? "" : ", ") + x;
-      return out;
-    };
-    h << "<tr><td><a href=\"#problem-" << html(p.name) << "\">" << html(p.name) << "</a></td><td>"
-      << html(joined(methods)) << "</td><td>" << html(joined(integrators)) << "</td><td class=\"num\">"
+    h << "<tr><td><a href=\"#problem-" << html_escape(p.name) << "\">" << html_escape(p.name) << "</a></td><td>"
+      << html_escape(joined(methods)) << "</td><td>" << html_escape(joined(integrators)) << "</td><td class=\"num\">"
       << p.cases.size() << "</td><td class=\"num\">" << ok << "</td><td class=\"num\">" << div
       << "</td><td class=\"num\">" << bad << "</td><td class=\"num\">" << na << "</td>";
-    for (double level : {1e-6, 1e-10}) {
-      const auto ranked = rank_at(p.wp, kMeasures[0], level);
-      if (ranked.empty()) {
-        h << "<td>none reaches it</td>";
-        continue;
-      }
-      h << "<td><span class=\"win\">" << html(ranked[0]->entry->curve) << "</span> "
-        << seconds_text(ranked[0]->wall_median);
-      for (const CaseResult* r : ranked)
-        if (r->entry->method != ranked[0]->entry->method) {
-          h << "; " << html(r->entry->method) << " " << sci(r->wall_median / ranked[0]->wall_median) << "&times; slower";
-          break;
-        }
-      h << "</td>";
-    }
+    for (double level : {1e-6, 1e-10}) html_fastest_cell(h, p, level);
     h << "</tr>\n";
   }
   h << "</table>\n";
+}
 
-  // Per problem.
-  for (const auto& p : problems) {
-    h << "<h2 id=\"problem-" << html(p.name) << "\">" << html(p.name) << "</h2>\n";
+// One row of a problem's "fastest method" table.
+void html_fastest_row(std::ostream& h, const ProblemView& p, const Measure& m, double level) {
+  const auto ranked = rank_at(p.wp, m, level);
+  h << "<tr><td>"
+    << (m.value == &CaseResult::drift && !p.drift_name.empty() ? "largest " + html_escape(p.drift_name) + " drift"
+                                                               : m.title)
+    << "</td><td class=\"num\">&le; " << sci(level) << "</td>";
+  if (ranked.empty()) {
+    h << "<td colspan=\"8\">no case reaches this level</td></tr>\n";
+    return;
+  }
+  const CaseResult& w = *ranked[0];
+  h << "<td class=\"win\">" << html_escape(w.entry->curve) << "</td><td>" << html_escape(case_setting(w))
+    << "</td><td class=\"num\">" << seconds_text(w.wall_median) << "</td><td class=\"num\">" << sci(w.*(m.value))
+    << "</td>";
+  const CaseResult* next = nullptr;
+  for (const CaseResult* r : ranked)
+    if (r->entry->method != w.entry->method) {
+      next = r;
+      break;
+    }
+  if (next)
+    h << "<td>" << html_escape(next->entry->curve) << "</td><td class=\"num\">" << seconds_text(next->wall_median)
+      << "</td><td class=\"num\">" << sci(next->wall_median / w.wall_median) << "&times;</td>";
+  else
+    h << "<td colspan=\"3\">no other method reaches it</td>";
+  h << "<td class=\"num\">" << ranked.size() << " of " << p.curves.size() << "</td></tr>\n";
+}
+
+// A drawn picture, inlined as PNG, with its caption; nothing if it was not drawn.
+void html_figure(std::ostream& h, const PlotSet& plots, const std::string& name) {
+  const std::string png = file_or_empty(plots.plot_dir + "/" + name + ".png");
+  if (png.empty()) return;
+  h << "<figure><img alt=\"" << html_escape(name) << "\" src=\"data:image/png;base64," << base64(png)
+    << "\"><figcaption>" << html_escape(plots.captions.at(name)) << " Files: <code>plots/" << html_escape(name)
+    << ".png</code>, <code>plots/" << html_escape(name) << ".svg</code>.</figcaption></figure>\n";
+}
+
+// Per problem: the fastest method at each accuracy level, then its pictures.
+void html_problems(std::ostream& h, const Page& pg) {
+  for (const auto& p : pg.problems) {
+    h << "<h2 id=\"problem-" << html_escape(p.name) << "\">" << html_escape(p.name) << "</h2>\n";
     h << "<h3>Fastest method at each accuracy level</h3>\n"
          "<p class=\"meta\">Among the work-precision cases that finished (status ok), the curve whose fastest case "
          "reaches the level; the runner-up is the fastest case of another method, with its time as a multiple of "
@@ -839,56 +807,23 @@ ReportResult build_report(const std::string& dir, const ReportOptions& opt, std:
          "<th>value</th><th>next other method</th><th>its wall</th><th>factor</th><th>curves reaching</th></tr>\n";
     for (const Measure& m : kMeasures) {
       if (m.value == &CaseResult::drift && p.drift_name.empty()) continue;
-      for (double level : accuracy_levels()) {
-        const auto ranked = rank_at(p.wp, m, level);
-        h << "<tr><td>" << (m.value == &CaseResult::drift && !p.drift_name.empty() ? "largest " + html(p.drift_name) + " drift" : m.title)
-          << "</td><td class=\"num\">&le; " << sci(level) << "</td>";
-        if (ranked.empty()) {
-          h << "<td colspan=\"8\">no case reaches this level</td></tr>\n";
-          continue;
-        }
-        const CaseResult& w = *ranked[0];
-        h << "<td class=\"win\">" << html(w.entry->curve) << "</td><td>" << html(case_setting(w))
-          << "</td><td class=\"num\">" << seconds_text(w.wall_median) << "</td><td class=\"num\">" << sci(w.*(m.value))
-          << "</td>";
-        const CaseResult* next = nullptr;
-        for (const CaseResult* r : ranked)
-          if (r->entry->method != w.entry->method) {
-            next = r;
-            break;
-          }
-        if (next)
-          h << "<td>" << html(next->entry->curve) << "</td><td class=\"num\">" << seconds_text(next->wall_median)
-            << "</td><td class=\"num\">" << sci(next->wall_median / w.wall_median) << "&times;</td>";
-        else
-          h << "<td colspan=\"3\">no other method reaches it</td>";
-        h << "<td class=\"num\">" << ranked.size() << " of " << p.curves.size() << "</td></tr>\n";
-      }
+      for (double level : accuracy_levels()) html_fastest_row(h, p, m, level);
     }
     h << "</table>\n";
-    for (const auto& name : p.plots) {
-      const std::string png = file_or_empty(plot_dir + "/" + name + ".png");
-      if (png.empty()) continue;
-      h << "<figure><img alt=\"" << html(name) << "\" src=\"data:image/png;base64," << base64(png)
-        << "\"><figcaption>" << html(captions[name]) << " Files: <code>plots/" << html(name)
-        << ".png</code>, <code>plots/" << html(name) << ".svg</code>.</figcaption></figure>\n";
-    }
+    for (const auto& name : p.plots) html_figure(h, pg.plots, name);
     if (p.plots.empty()) h << "<p>No finished runs to plot.</p>\n";
   }
+}
 
-  // Stress tests.
-  if (!stress.empty) {
-    h << "<h2 id=\"stress\">Stress</h2>\n" << stress.html;
-    for (const auto& name : stress_plots) {
-      const std::string png = file_or_empty(plot_dir + "/" + name + ".png");
-      if (png.empty()) continue;
-      h << "<figure><img alt=\"" << html(name) << "\" src=\"data:image/png;base64," << base64(png)
-        << "\"><figcaption>" << html(captions[name]) << " Files: <code>plots/" << html(name)
-        << ".png</code>, <code>plots/" << html(name) << ".svg</code>.</figcaption></figure>\n";
-    }
-  }
+// The Stress section: its tables and pictures.
+void html_stress(std::ostream& h, const Page& pg) {
+  if (pg.stress.empty) return;
+  h << "<h2 id=\"stress\">Stress</h2>\n" << pg.stress.html;
+  for (const auto& name : pg.stress_plots) html_figure(h, pg.plots, name);
+}
 
-  // All cases.
+// "All cases": one row per case; the not-applicable ones folded into their own table.
+void html_all_cases(std::ostream& h, const Page& pg) {
   h << "<h2 id=\"cases\">All cases</h2>\n<p class=\"meta\">One row per case (repeats folded: wall time is their "
        "median). Every repeat is a row of <code>summary.csv</code>; the tidy work-precision table is "
        "<code>work_precision.csv</code>, the rankings <code>fastest.csv</code>.</p>\n";
@@ -896,45 +831,44 @@ ReportResult build_report(const std::string& dir, const ReportOptions& opt, std:
        "<th>integrator</th><th>setting</th><th>t_end</th><th>status</th><th>wall (median)</th><th>repeats ok</th>"
        "<th>steps</th><th>ref error</th><th>digits</th><th>max residual</th><th>max drift</th><th>reason</th></tr>\n";
   std::map<std::string, std::pair<size_t, std::string>> not_applicable;  // "problem method integrator" -> count, reason
-  for (const CaseResult& c : results) {
-    if (c.complete && c.status == "invalid") {
+  for (const CaseResult& c : pg.results) {
+    if (c.status == Status::kInvalid) {
       auto& slot = not_applicable[c.entry->problem + " / " + c.entry->method + " / " + c.entry->integrator];
       ++slot.first;
       slot.second = c.reason;
       continue;
     }
-    const char* cls = !c.complete || (c.status != "ok" && c.status != "diverged") ? " class=\"bad\""
-                      : c.status == "diverged"                                     ? " class=\"div\""
-                                                                                   : "";
+    const char* cls = c.status == Status::kOk ? "" : c.status == Status::kDiverged ? " class=\"div\"" : " class=\"bad\"";
     h << "<tr" << cls << "><td class=\"num\">" << c.entry->index << "</td><td><code>" << c.entry->id
-      << "</code></td><td>" << html(c.entry->sweep) << "</td><td>" << html(c.entry->problem) << "</td><td>"
-      << html(c.entry->method) << "</td><td>" << html(c.formulation) << "</td><td>" << html(c.entry->integrator)
-      << "</td><td>" << html(case_setting(c)) << "</td><td class=\"num\">" << format_short(c.entry->t_end)
-      << "</td><td>" << html(c.status) << "</td><td class=\"num\">" << seconds_text(c.wall_median)
-      << "</td><td class=\"num\">" << c.ok_repeats << "/" << c.entry->repeats << "</td><td class=\"num\">"
-      << html(c.steps) << "</td><td class=\"num\">" << sci(c.ref_error) << "</td><td class=\"num\">"
-      << (std::isnan(c.ref_scd) ? "" : sci(c.ref_scd)) << "</td><td class=\"num\">" << sci(c.max_residual)
-      << "</td><td class=\"num\">" << sci(c.drift) << "</td><td class=\"reason\">" << html(c.reason)
-      << "</td></tr>\n";
+      << "</code></td><td>" << html_escape(c.entry->sweep) << "</td><td>" << html_escape(c.entry->problem)
+      << "</td><td>" << html_escape(c.entry->method) << "</td><td>" << html_escape(c.formulation) << "</td><td>"
+      << html_escape(c.entry->integrator) << "</td><td>" << html_escape(case_setting(c)) << "</td><td class=\"num\">"
+      << format_short(c.entry->t_end) << "</td><td>" << html_escape(status_name(c.status))
+      << "</td><td class=\"num\">" << seconds_text(c.wall_median) << "</td><td class=\"num\">" << c.ok_repeats << "/"
+      << c.entry->repeats << "</td><td class=\"num\">" << count_cell(c.steps) << "</td><td class=\"num\">"
+      << sci(c.ref_error) << "</td><td class=\"num\">" << (std::isnan(c.ref_scd) ? "" : sci(c.ref_scd))
+      << "</td><td class=\"num\">" << sci(c.max_residual) << "</td><td class=\"num\">" << sci(c.drift)
+      << "</td><td class=\"reason\">" << html_escape(c.reason) << "</td></tr>\n";
   }
   h << "</table></div>\n";
-  if (!not_applicable.empty()) {
-    h << "<h3>Not applicable</h3>\n<p class=\"meta\">Combinations the harness rejected before running "
-         "(status <code>invalid</code> in summary.csv).</p>\n<table><tr><th>problem / method / integrator</th>"
-         "<th>cases</th><th>reason</th></tr>\n";
-    for (const auto& [key, v] : not_applicable)
-      h << "<tr><td>" << html(key) << "</td><td class=\"num\">" << v.first << "</td><td>" << html(v.second)
-        << "</td></tr>\n";
-    h << "</table>\n";
-  }
+  if (not_applicable.empty()) return;
+  h << "<h3>Not applicable</h3>\n<p class=\"meta\">Combinations the harness rejected before running "
+       "(status <code>invalid</code> in summary.csv).</p>\n<table><tr><th>problem / method / integrator</th>"
+       "<th>cases</th><th>reason</th></tr>\n";
+  for (const auto& [key, v] : not_applicable)
+    h << "<tr><td>" << html_escape(key) << "</td><td class=\"num\">" << v.first << "</td><td>"
+      << html_escape(v.second) << "</td></tr>\n";
+  h << "</table>\n";
+}
 
-  // Provenance and the matrix.
+// Provenance, the matrix, warnings and the image-check script.
+void html_tail(std::ostream& h, const Page& pg) {
   h << "<h2 id=\"provenance\">Provenance</h2>\n<table>";
-  if (prov.empty()) h << "<tr><td>no provenance.txt in this folder</td></tr>";
-  for (const auto& [k, v] : prov) h << "<tr><th>" << html(k) << "</th><td>" << html(v) << "</td></tr>\n";
-  h << "</table>\n<details><summary>The matrix (matrix.toml)</summary><pre>" << html(file_or_empty(dir + "/matrix.toml"))
-    << "</pre></details>\n";
-  for (const auto& w : result.warnings) h << "<p class=\"meta\">warning: " << html(w) << "</p>\n";
+  if (pg.prov.empty()) h << "<tr><td>no provenance.txt in this folder</td></tr>";
+  for (const auto& [k, v] : pg.prov) h << "<tr><th>" << html_escape(k) << "</th><td>" << html_escape(v) << "</td></tr>\n";
+  h << "</table>\n<details><summary>The matrix (matrix.toml)</summary><pre>"
+    << html_escape(file_or_empty(pg.dir + "/matrix.toml")) << "</pre></details>\n";
+  for (const auto& w : pg.warnings) h << "<p class=\"meta\">warning: " << html_escape(w) << "</p>\n";
   // Marks the page once every image has been decoded; scripts/check-report.sh reads these attributes.
   h << R"(<script>
 window.addEventListener('load', function () {
@@ -946,8 +880,48 @@ window.addEventListener('load', function () {
 </script>
 </body></html>
 )";
+}
+
+// The whole page.
+std::string report_html(const Page& pg) {
+  std::ostringstream h;
+  html_head(h, pg);
+  html_overview(h, pg);
+  html_problems(h, pg);
+  html_stress(h, pg);
+  html_all_cases(h, pg);
+  html_tail(h, pg);
+  return h.str();
+}
+
+}  // namespace
+
+ReportResult build_report(const std::string& dir, const ReportOptions& opt, std::ostream& log) {
+  ReportResult result;
+  // Parse the folder once.
+  const ResultsFolder folder = load_report_input(dir);
+  // Group the cases by problem.
+  std::vector<ProblemView> problems = group_by_problem(folder.cases);
+  // The tables.
+  write_work_precision_csv(dir, problems);
+  write_fastest_csv(dir, problems);
+  // The pictures' data, per problem and for the Stress section.
+  PlotSet plots;
+  plots.plot_dir = dir + "/plots";
+  std::error_code ec;
+  fs::create_directories(plots.plot_dir + "/data", ec);
+  plan_problem_plots(plots, dir, problems);
+  const StressSection stress = build_stress_section(folder);
+  const std::vector<std::string> stress_plots = plan_stress_plots(plots, stress);
+  // replot.sh, then gnuplot for what changed.
+  const std::string scripts = opt.plot_scripts.empty() ? find_plot_scripts() : opt.plot_scripts;
+  write_replot_script(plots, scripts);
+  if (opt.plots) draw_plots(plots, scripts, opt.jobs, result);
+  // report.html.
+  const Provenance prov = parse_provenance(file_or_empty(dir + "/provenance.txt"));
+  const Page page{dir, folder.cases, problems, stress, stress_plots, plots, prov, result.warnings};
   result.html = dir + "/report.html";
-  write_file_atomic(result.html, h.str());
+  write_file_atomic(result.html, report_html(page));
   for (const auto& w : result.warnings) log << "report: warning: " << w << "\n";
   return result;
 }

@@ -22,7 +22,7 @@
 #include <string>
 #include <vector>
 
-#include "matrix/matrix.hpp"
+#include "matrix/results.hpp"
 
 namespace cstab {
 
@@ -40,9 +40,8 @@ struct StressSection {
   std::vector<StressPlot> plots;
 };
 
-// Reads DIR's cases and summary; writes DIR/stress_*.csv for what it finds.
-StressSection build_stress_section(const std::string& dir, const std::vector<CaseEntry>& entries,
-                                   const CsvTable& summary);
+// From the cases of a results folder; writes DIR/stress_*.csv for what it finds.
+StressSection build_stress_section(const ResultsFolder& folder);
 
 // "bounded", "~sqrt(t)", "~linear", "faster than linear", or "" for NaN.
 std::string drift_growth_class(double exponent);

@@ -18,6 +18,7 @@
 
 #include "gate/gate.hpp"
 #include "matrix/matrix.hpp"
+#include "matrix/results.hpp"
 #include "tests/test_util.hpp"
 
 namespace fs = std::filesystem;
@@ -125,6 +126,126 @@ TEST(GateThresholds, QuotedCellsAndCommentsAreAccepted) {
   EXPECT_TRUE(std::isnan(f.rows[0].max_residual));
 }
 
+TEST(GateThresholds, KeyValuesCompareNumbersAsNumbers) {
+  EXPECT_TRUE(cstab::same_key_values("step=1e-3", "step=0.001"));
+  EXPECT_TRUE(cstab::same_key_values("step=0.001;perturb=1e-3", "perturb=0.001;step=1E-3"));
+  EXPECT_TRUE(cstab::same_key_values("alpha=5;beta=5", "beta=5.0;alpha=5"));
+  EXPECT_TRUE(cstab::same_key_values("", ""));
+  EXPECT_FALSE(cstab::same_key_values("step=1e-3", "step=1e-4"));
+  EXPECT_FALSE(cstab::same_key_values("step=1e-3", "tol=1e-3"));
+  EXPECT_FALSE(cstab::same_key_values("step=1e-3", "step=1e-3;perturb=0.001"));
+  EXPECT_FALSE(cstab::same_key_values("form=a", "form=b"));
+  EXPECT_EQ(cstab::canonical_key_values("step=1e-3;alpha=5.0"), "alpha=5;step=0.001");
+}
+
+TEST(GateThresholds, StatusNamesRoundTrip) {
+  using cstab::Status;
+  for (Status s : {Status::kOk, Status::kDiverged, Status::kFailed, Status::kTimeout, Status::kCrashed,
+                   Status::kInvalid, Status::kNotRun}) {
+    const auto back = cstab::parse_status(cstab::status_name(s));
+    ASSERT_TRUE(back.has_value()) << cstab::status_name(s);
+    EXPECT_EQ(*back, s) << cstab::status_name(s);
+  }
+  EXPECT_STREQ(cstab::status_name(Status::kNotRun), "not run");
+  EXPECT_FALSE(cstab::parse_status("fine").has_value());
+  EXPECT_FALSE(cstab::parse_status("OK").has_value());
+  EXPECT_EQ(cstab::status_from_cell("timeout"), Status::kTimeout);
+  EXPECT_EQ(cstab::status_from_cell("not run"), Status::kFailed);  // never written: not a result
+  EXPECT_TRUE(cstab::is_gateable(Status::kDiverged));
+  EXPECT_FALSE(cstab::is_gateable(Status::kInvalid));
+  EXPECT_FALSE(cstab::is_gateable(Status::kTimeout));
+}
+
+// The loader the gate and the report share, on a hand-written folder: a
+// case whose second repeat diverged is diverged (with that repeat's
+// reason), its median is over the ok repeats only; a case without key.txt
+// is not run; "1e-3" in summary.csv reads as 0.001.
+TEST(GateThresholds, ResultsModelFoldsRepeats) {
+  Scratch s("cstab_model");
+  const std::string dir = (s.dir() / "r").string();
+  std::vector<cstab::CaseEntry> entries(3);
+  for (size_t i = 0; i < entries.size(); ++i) {
+    entries[i].index = i;
+    entries[i].id = "000000000000000" + std::to_string(i);
+    entries[i].problem = "wheel";
+    entries[i].method = "baumgarte";
+    entries[i].integrator = "rk4";
+    entries[i].setting = "step=0.001";
+    entries[i].t_end = 1;
+    entries[i].repeats = 3;
+    entries[i].curve = "baumgarte/rk4";
+    fs::create_directories(dir + "/cases/" + entries[i].id);
+  }
+  cstab::write_manifest(dir + "/cases.csv", entries, entries.size());
+  const std::string head = "case_id,repeat,status,reason,step,wall_seconds,max_residual,energy_law,max_energy_drift\n";
+  write(dir + "/cases/0000000000000000/summary.csv",
+        head + "0000000000000000,0,ok,,1e-3,0.5,1e-9,yes,1e-6\n0000000000000000,1,ok,,1e-3,0.25,2e-9,yes,1e-6\n"
+               "0000000000000000,2,diverged,residual above 1e3,1e-3,0.1,5e3,yes,\n");
+  write(dir + "/cases/0000000000000000/key.txt", "k\n");
+  write(dir + "/cases/0000000000000001/summary.csv",
+        "case_id,repeat,status,reason,t_end\n0000000000000001,0,timeout,killed after 1 s (timeout),1\n");
+  write(dir + "/cases/0000000000000001/key.txt", "k\n");
+  write(dir + "/cases/0000000000000002/summary.csv", head + "0000000000000002,0,ok,,1e-3,0.5,1e-9,yes,1e-6\n");
+  // no key.txt: incomplete
+  const cstab::ResultsFolder f = cstab::load_results_folder(dir);
+  ASSERT_EQ(f.cases.size(), 3u);
+  const cstab::CaseResult& a = f.cases[0];
+  EXPECT_TRUE(a.complete);
+  EXPECT_EQ(a.status, cstab::Status::kDiverged);
+  EXPECT_EQ(a.reason, "residual above 1e3");
+  EXPECT_EQ(a.repeats.size(), 3u);
+  EXPECT_EQ(a.ok_repeats, 2);
+  EXPECT_DOUBLE_EQ(a.wall_median, 0.375);
+  EXPECT_EQ(a.wall_min, 0.25);
+  EXPECT_EQ(a.wall_max, 0.5);
+  EXPECT_EQ(a.step, 0.001);
+  EXPECT_EQ(a.max_residual, 5e3);  // the largest over the repeats
+  EXPECT_EQ(a.drift, 1e-6);
+  EXPECT_EQ(a.steps, -1);  // no steps column: not recorded
+  const cstab::CaseResult& b = f.cases[1];
+  EXPECT_TRUE(b.complete);
+  EXPECT_EQ(b.status, cstab::Status::kTimeout);
+  EXPECT_TRUE(std::isnan(b.wall_median));
+  EXPECT_TRUE(std::isnan(b.max_residual));
+  const cstab::CaseResult& c = f.cases[2];
+  EXPECT_FALSE(c.complete);
+  EXPECT_EQ(c.status, cstab::Status::kNotRun);
+  // DIR/summary.csv: the complete cases' rows as written, the sweep after "repeat".
+  EXPECT_EQ(cstab::write_matrix_summary(dir, f.entries), 1u);
+  const cstab::CsvTable t = cstab::read_csv(dir + "/summary.csv");
+  ASSERT_EQ(t.rows.size(), 4u);
+  EXPECT_EQ(t.header[2], "sweep");
+  EXPECT_EQ(t.get(0, "step"), "1e-3");
+  EXPECT_EQ(t.get(3, "status"), "timeout");
+}
+
+// A manifest with a cell that is not a number is not a results folder (a
+// UsageError naming the file, row and column), for the gate and the report alike.
+TEST(GateThresholds, ManifestNumbersAreChecked) {
+  Scratch s("cstab_manifest");
+  const std::string dir = s.dir().string();
+  const std::string head = "index,case_id,sweep,problem,method,formulation,integrator,params,setting,t_end,repeats,"
+                           "work_precision,overlay,curve,selected_cases\n";
+  write(dir + "/cases.csv", head + "0,0000000000000000,a,wheel,baumgarte,,rk4,,step=0.001,1e-1,3,1,0,c,1\n");
+  const auto entries = cstab::read_results_manifest(dir);
+  ASSERT_EQ(entries.size(), 1u);
+  EXPECT_EQ(entries[0].t_end, 0.1);
+  EXPECT_EQ(entries[0].repeats, 3);
+  for (const auto& [row, what] : std::vector<std::pair<std::string, std::string>>{
+           {"0,0000000000000000,a,wheel,baumgarte,,rk4,,step=0.001,soon,3,1,0,c,1", "t_end: 'soon' is not a number"},
+           {"0,0000000000000000,a,wheel,baumgarte,,rk4,,step=0.001,1,2.5,1,0,c,1", "repeats: '2.5' is not a count"},
+           {"x,0000000000000000,a,wheel,baumgarte,,rk4,,step=0.001,1,3,1,0,c,1", "index: 'x' is not a count"}}) {
+    write(dir + "/cases.csv", head + row + "\n");
+    try {
+      cstab::read_results_manifest(dir);
+      ADD_FAILURE() << row;
+    } catch (const UsageError& e) {
+      EXPECT_NE(std::string(e.what()).find("not a matrix results folder"), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find("cases.csv: row 2: " + what), std::string::npos) << e.what();
+    }
+  }
+}
+
 // ------------------------------------------------- gate on a small matrix
 
 // Two wheel cases, run once per test suite.
@@ -195,15 +316,77 @@ TEST_F(GateEvaluate, PassesWhenEveryBoundHoldsAndFailsOnOneThatDoesNot) {
 
 TEST_F(GateEvaluate, MissingCaseFailsAndIsNamed) {
   const Outcome o = gate("problem,method,integrator,setting,max_residual\n"
-                         "wheel,baumgarte,rk4,step=1e-3,1\n"  // written differently from the folder's step=0.001
+                         "wheel,baumgarte,rk4,step=1e-2,1\n"  // the folder has step=0.001 only
                          "ball,baumgarte,rk4,step=0.001,1\n");
   EXPECT_EQ(o.code, 1) << o.out;
-  EXPECT_NE(o.out.find("wheel baumgarte rk4 step=1e-3"), std::string::npos) << o.out;
+  EXPECT_NE(o.out.find("wheel baumgarte rk4 step=1e-2"), std::string::npos) << o.out;
   EXPECT_NE(o.out.find("no such case in the results folder; it has wheel baumgarte rk4 at step=0.001"),
             std::string::npos)
       << o.out;
   EXPECT_NE(o.out.find("ball baumgarte rk4 step=0.001"), std::string::npos) << o.out;
   EXPECT_NE(o.out.find("2 checks, 2 failed"), std::string::npos) << o.out;
+}
+
+// The results model reads the folder back: statuses, repeats, the median
+// of the ok repeats' wall times, numbers as written.
+TEST_F(GateEvaluate, ResultsFolderLoadsEveryCase) {
+  const cstab::ResultsFolder f = cstab::load_results_folder(dir_);
+  ASSERT_EQ(f.cases.size(), 3u);
+  ASSERT_EQ(f.entries.size(), 3u);
+  bool saw_baumgarte = false, saw_none = false, saw_minimal = false;
+  for (size_t i = 0; i < f.cases.size(); ++i) {
+    const cstab::CaseResult& c = f.cases[i];
+    EXPECT_EQ(c.entry, &f.entries[i]);
+    ASSERT_TRUE(c.complete) << c.entry->label();
+    if (c.entry->method == "baumgarte") {
+      saw_baumgarte = true;
+      EXPECT_EQ(c.status, cstab::Status::kOk);
+      EXPECT_EQ(c.repeats.size(), 3u);
+      EXPECT_EQ(c.ok_repeats, 3);
+      EXPECT_EQ(c.wall_median, median_wall("baumgarte"));
+      EXPECT_LE(c.wall_min, c.wall_median);
+      EXPECT_GE(c.wall_max, c.wall_median);
+      EXPECT_EQ(c.step, 0.001);
+      EXPECT_TRUE(std::isnan(c.rtol));
+      EXPECT_EQ(c.max_residual, std::stod(rows_of("baumgarte").at(0).at("max_residual")));
+      EXPECT_EQ(c.steps, std::stol(rows_of("baumgarte").at(0).at("steps")));
+      EXPECT_TRUE(c.energy_law);
+      EXPECT_EQ(c.drift_name, "energy");
+      EXPECT_EQ(c.drift, c.max_energy_drift);
+    }
+    if (c.entry->method == "none") {  // unstabilized, but finishes (the status test expects ok)
+      saw_none = true;
+      EXPECT_EQ(c.status, cstab::Status::kOk);
+      EXPECT_EQ(c.ok_repeats, 3);
+      EXPECT_EQ(c.wall_median, median_wall("none"));
+      EXPECT_TRUE(c.reason.empty());
+    }
+    if (c.entry->method == "minimal") {
+      saw_minimal = true;
+      EXPECT_EQ(c.rtol, 1e-10);
+      EXPECT_TRUE(std::isnan(c.step));
+      EXPECT_GT(c.rhs_evals, 0);
+    }
+  }
+  EXPECT_TRUE(saw_baumgarte && saw_none && saw_minimal);
+}
+
+// Keys are matched by meaning: step "1e-3" names the folder's step=0.001
+// case, and the two spellings in one file are the same case.
+TEST_F(GateEvaluate, SettingNumbersMatchAsNumbers) {
+  const std::string head = "problem,method,integrator,setting,max_residual\n";
+  for (const char* setting : {"step=1e-3", "step=0.0010", "step=1.0e-03"}) {
+    const Outcome o = gate(head + "wheel,baumgarte,rk4," + setting + ",1\n");
+    EXPECT_EQ(o.code, 0) << setting << "\n" << o.out;
+    EXPECT_NE(o.out.find("2 checks, 0 failed"), std::string::npos) << setting << "\n" << o.out;
+    EXPECT_EQ(o.out.find("no such case"), std::string::npos) << setting << "\n" << o.out;
+  }
+  const Outcome near = gate(head + "wheel,baumgarte,rk4,step=0.0011,1\n");  // a different number
+  EXPECT_EQ(near.code, 1) << near.out;
+  EXPECT_NE(near.out.find("no such case in the results folder"), std::string::npos) << near.out;
+  const Outcome dup = gate(head + "wheel,baumgarte,rk4,step=1e-3,1\nwheel,baumgarte,rk4,step=0.001,1\n");
+  EXPECT_EQ(dup.code, 2) << dup.out;
+  EXPECT_NE(dup.out.find("duplicate case"), std::string::npos) << dup.out;
 }
 
 TEST_F(GateEvaluate, ExpectedStatusAndMissingValuesAreChecked) {

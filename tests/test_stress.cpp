@@ -11,6 +11,9 @@
 
 #include "matrix/matrix.hpp"
 #include "harness/run.hpp"
+#include "io/csv.hpp"
+#include "io/number.hpp"
+#include "io/text.hpp"
 #include "report/stress_report.hpp"
 #include "methods/pair.hpp"
 #include "problems/registry.hpp"
@@ -296,3 +299,27 @@ TEST(StressGrowth, Classes) {
 
 }  // namespace
 }  // namespace cstab
+
+// The writers the report and the stress section share (io/text, io/csv,
+// io/number): one escaper, one quoter, one CSV line writer, one number format.
+TEST(ReportText, EscapersQuotersAndCells) {
+  EXPECT_EQ(cstab::html_escape("a<b & \"c\">"), "a&lt;b &amp; &quot;c&quot;&gt;");
+  EXPECT_EQ(cstab::html_escape("plain"), "plain");
+  EXPECT_EQ(cstab::gnuplot_string("it's"), "'it''s'");
+  EXPECT_EQ(cstab::gnuplot_string(" 1 2"), "' 1 2'");
+  EXPECT_EQ(cstab::gnuplot_data_title("say \"hi\""), "\"say 'hi'\"");
+  EXPECT_EQ(cstab::csv_line({"a", "b,c", "d\"e", ""}), "a,\"b,c\",\"d\"\"e\",\n");
+  EXPECT_EQ(cstab::rows_to_csv({{{"x", "1"}, {"y", "2"}}, {{"z", "3"}, {"x", "4"}}}), "x,y,z\n1,2,\n4,,3\n");
+  EXPECT_EQ(cstab::number_cell(std::nan("")), "");
+  EXPECT_EQ(cstab::number_cell(0.1), "0.10000000000000001");
+  EXPECT_EQ(cstab::parse_number(cstab::number_cell(0.1)), 0.1);
+  EXPECT_EQ(cstab::parse_number("1e-3"), 0.001);
+  EXPECT_TRUE(std::isnan(cstab::parse_number("")));
+  EXPECT_TRUE(std::isnan(cstab::parse_number("1e-3x")));  // the whole cell must be a number
+  EXPECT_EQ(cstab::parse_number("inf"), INFINITY);
+  EXPECT_EQ(cstab::count_cell(-1), "");
+  EXPECT_EQ(cstab::count_cell(42), "42");
+  EXPECT_EQ(cstab::log_plot_cell(0), "?");
+  EXPECT_EQ(cstab::log_plot_cell(-1), "?");
+  EXPECT_EQ(cstab::log_plot_cell(2.5), "2.5");
+}

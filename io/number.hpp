@@ -1,0 +1,27 @@
+// Numbers in the text files of a results folder: written in one form, read
+// back by one parser.
+#pragma once
+
+#include <string>
+
+namespace cstab {
+
+// A cell for a value that may be missing: "" for NaN, else round-trip
+// exact (format_exact).
+std::string number_cell(double v);
+
+// A count cell: "" for a negative count (not recorded), else the integer.
+std::string count_cell(long n);
+
+// A value in a gnuplot data file for a log-scale axis: round-trip exact if
+// finite and > 0, else "?" (gnuplot's missing value).
+std::string log_plot_cell(double v);
+
+// The number a whole cell holds ("1e-3", "0.001", "inf", "nan"); NaN if the
+// cell is empty or is not entirely a number (leading/trailing blanks aside).
+double parse_number(const std::string& text);
+
+// As parse_number, but says whether the cell was a number at all.
+bool try_parse_number(const std::string& text, double& value);
+
+}  // namespace cstab
