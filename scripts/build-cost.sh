@@ -35,6 +35,8 @@ cpu_since() {  # CPU seconds and count of the units compiled since line $1 of th
 : >"$log"
 clean=$(build)
 echo "clean build (everything, tests included, -j$jobs): ${clean} s"
+echo "  compiler warnings: $(grep -c 'warning:' "$work/build.out" || true)"
+grep -A3 'warning:' "$work/build.out" | head -20 | sed 's/^/    /' || true
 awk '{s += $1; if ($2 > m) {m = $2; f = $3}} END {printf "  %d units, %.0f s CPU; peak compiler memory %.0f MB (%s)\n", NR, s, m / 1024, f}' "$log"
 echo "  slowest units:"
 sort -rn "$log" | head -5 | awk '{printf "    %5.1f s %6.0f MB  %s\n", $1, $2 / 1024, $3}'

@@ -44,9 +44,16 @@ struct Outcome {
 
 Outcome run_cli(const std::vector<std::string>& args, const fs::path& scratch) {
   std::string cmd = quote(CSTAB_BINARY);
-  for (const auto& a : args) cmd += " " + quote(a);
+  // (appended piecewise: `" " + std::string&&` trips GCC 12's -Wrestrict false positive)
+  for (const auto& a : args) {
+    cmd += ' ';
+    cmd += quote(a);
+  }
   const fs::path out = scratch / "stdout.txt", err = scratch / "stderr.txt";
-  cmd += " >" + quote(out.string()) + " 2>" + quote(err.string());
+  cmd += " >";
+  cmd += quote(out.string());
+  cmd += " 2>";
+  cmd += quote(err.string());
   const int status = std::system(cmd.c_str());
   Outcome o;
   o.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
