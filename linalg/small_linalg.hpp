@@ -3,7 +3,7 @@
 // compile-time bounds. Eigen's LLT and triangular solves on fixed-size
 // matrices of these sizes dispatch to its blocked (BLAS-like) kernels with
 // packing, which dominated the right-hand sides in the profile (docs/measurements.md,
-// Speed); these loops compute the same factorization (tests/test_small_linalg.cpp
+// Speed); these loops compute the same factorization (tests/unit/test_small_linalg.cpp
 // checks them against Eigen's LLT and against a KKT solve).
 #pragma once
 

@@ -22,7 +22,7 @@
 // Every derivative (Jacobians, the acceleration-level terms, the energy
 // gradient) comes from forward-mode AD here; models write only the functions.
 // A model may also give its holonomic rows' derivatives in closed form (a
-// hand-derived fast path; tests/test_closed_forms.cpp checks each against AD):
+// hand-derived fast path; tests/unit/test_closed_forms.cpp checks each against AD):
 //   template <class Terms> void closed_form_holonomic(double t, const Vec<double,nq>& q,
 //                                                    const Vec<double,nq>* v, Terms& terms) const;
 // setting terms.phi, the first nh rows of terms.A (J = dPhi/dq), terms.phi_t

@@ -4,6 +4,9 @@
 #   bash scripts/compare-results.sh BEFORE_DIR AFTER_DIR
 # Prints how many rows are identical, lists every other difference (column,
 # both values, relative difference for numbers), and exits 1 if any.
+# Only each case's first run (repeat 0) is compared: how many timing repeats
+# a case gets depends on its wall time (repeat_if_under), and a repeat's
+# numbers other than its timings are those of the first run.
 set -euo pipefail
 [[ $# -eq 2 ]] || { echo "usage: $0 BEFORE_DIR AFTER_DIR" >&2; exit 2; }
 command -v python3 >/dev/null || { echo "compare-results: needs python3 (apt-get install python3)" >&2; exit 2; }
@@ -16,7 +19,8 @@ def load(path):
                      r["rtol"], r["atol"], r["t_end"], r.get("sweep", ""), r.get("repeat", ""), r.get("perturb", ""))
     out = {}
     for r in rows:
-        out.setdefault(key(r), r)
+        if r.get("repeat", "0") == "0":
+            out.setdefault(key(r), r)
     return out, (rows[0].keys() if rows else [])
 before, cols_b = load(sys.argv[1])
 after, cols_a = load(sys.argv[2])

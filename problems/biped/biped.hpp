@@ -106,7 +106,7 @@
 // 8.7e-6 m from the flow's end point. So the harness's reference error at
 // t = 10 is ~5e-3 for braun-goldfarb and projection at every step: the
 // contact shift, not the integration error. The accuracy check in
-// tests/test_biped.cpp reads X1, X2 off the numerical solution after the
+// tests/unit/test_biped.cpp reads X1, X2 off the numerical solution after the
 // transient and compares the whole motion with the exact solution for those
 // constants (exact_state()).
 #pragma once

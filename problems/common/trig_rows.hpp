@@ -3,7 +3,7 @@
 // value, the Jacobian row and the second derivative along q + s v
 // (d^2/ds^2 K cos(theta) = -K cos(theta) theta'^2, theta' = dtheta/dq v).
 // Models use it for closed_form_holonomic (methods/mechanical.hpp), which
-// tests/test_closed_forms.cpp checks against AD.
+// tests/unit/test_closed_forms.cpp checks against AD.
 #pragma once
 
 #include <Eigen/Dense>

@@ -131,7 +131,7 @@ class WheelStateSpace {
   //   L_B f2 = -sin(alpha) B_xd + cos(alpha) B_zd + r B_thd - (xdot cos(alpha) + zdot sin(alpha)) B_alpha,
   //   L_F f3 = -P2 sin(alpha) xdot,
   //   L_B f3 = (P2 r sin^2(alpha) - P1 cos(alpha) + sin(alpha)) B_alpha.
-  // tests/test_wheel.cpp checks it against the AD jet and finite differences.
+  // tests/unit/test_wheel.cpp checks it against the AD jet and finite differences.
   template <class Jet>
   void closed_form_jet(double t, const Vec<double, kStates>& X, Jet& jet) const {
     const double Mm = p_.M + p_.m, gamma = p_.m / p_.M;

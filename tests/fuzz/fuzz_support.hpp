@@ -1,7 +1,7 @@
 // A stand-in catalog for the matrix fuzz targets: problems and methods with
 // the shapes expand_matrix has to handle (a method that does not apply, one
 // whose parameters depend on the formulation, bounds of every kind), without
-// linking the real models. The real registry is covered by tests/test_matrix.cpp.
+// linking the real models. The real registry is covered by tests/unit/test_matrix.cpp.
 #pragma once
 
 #include <memory>

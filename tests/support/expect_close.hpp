@@ -1,5 +1,5 @@
 // Comparison of a closed-form result with its AD counterpart, shared by the
-// closed-form tests (tests/test_closed_forms.cpp, tests/test_wheel.cpp).
+// closed-form tests (tests/unit/test_closed_forms.cpp, tests/unit/test_wheel.cpp).
 #pragma once
 
 #include <gtest/gtest.h>

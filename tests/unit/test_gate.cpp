@@ -19,7 +19,7 @@
 #include "gate/gate.hpp"
 #include "matrix/matrix.hpp"
 #include "matrix/results.hpp"
-#include "tests/test_util.hpp"
+#include "tests/support/test_util.hpp"
 
 namespace fs = std::filesystem;
 using cstab::ThresholdsFile;

@@ -18,7 +18,7 @@
 
 #include "cli/matrix_commands.hpp"
 #include "matrix/matrix.hpp"
-#include "tests/test_util.hpp"
+#include "tests/support/test_util.hpp"
 #include "methods/pair.hpp"
 #include "problems/registry.hpp"
 

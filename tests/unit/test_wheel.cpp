@@ -20,7 +20,7 @@
 #include "methods/pesterev.hpp"
 #include "problems/registry.hpp"
 #include "problems/wheel/wheel.hpp"
-#include "tests/expect_close.hpp"
+#include "tests/support/expect_close.hpp"
 
 namespace cstab {
 namespace {

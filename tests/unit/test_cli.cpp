@@ -6,7 +6,7 @@
 #include "cli/args.hpp"
 #include "core/problem.hpp"
 #include "problems/registry.hpp"
-#include "tests/test_util.hpp"
+#include "tests/support/test_util.hpp"
 #include <sys/wait.h>
 #include <unistd.h>
 

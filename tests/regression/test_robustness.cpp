@@ -24,7 +24,7 @@
 #include "methods/pesterev.hpp"
 #include "methods/problem_adapter.hpp"
 #include "problems/registry.hpp"
-#include "tests/test_util.hpp"
+#include "tests/support/test_util.hpp"
 
 namespace cstab {
 namespace {

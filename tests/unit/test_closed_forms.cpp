@@ -17,7 +17,7 @@
 #include "problems/car_axis/car_axis.hpp"
 #include "problems/slider_crank/slider_crank.hpp"
 #include "problems/wheel/wheel_sharp.hpp"
-#include "tests/expect_close.hpp"
+#include "tests/support/expect_close.hpp"
 
 namespace cstab {
 namespace {

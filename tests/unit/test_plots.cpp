@@ -2,7 +2,7 @@
 // is a PNG, and gnuplot reports no error.
 #include <gtest/gtest.h>
 
-#include "tests/test_util.hpp"
+#include "tests/support/test_util.hpp"
 #include <sys/wait.h>
 #include <unistd.h>
 

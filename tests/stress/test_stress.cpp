@@ -18,7 +18,7 @@
 #include "methods/pair.hpp"
 #include "problems/registry.hpp"
 #include "problems/wheel/wheel_sharp.hpp"
-#include "tests/test_util.hpp"
+#include "tests/support/test_util.hpp"
 
 namespace cstab {
 namespace {
