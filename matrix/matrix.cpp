@@ -1,8 +1,7 @@
-// Matrix files: parsing (a strict TOML subset) and deterministic expansion.
+// Matrix files: parsing (TOML, read by toml++) and deterministic expansion.
 #include "matrix/matrix.hpp"
 
 #include <algorithm>
-#include <cerrno>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -14,6 +13,9 @@
 #include <set>
 #include <sstream>
 #include <stdexcept>
+#include <string_view>
+
+#include <toml++/toml.h>
 
 #include "core/format.hpp"
 #include "harness/integrator.hpp"
@@ -44,7 +46,9 @@ std::string read_text_file(const std::string& path) {
 }
 
 // ===========================================================================
-// Parser
+// Parser: toml++ reads the TOML; this maps its tree onto MatrixFile (sections
+// and entries in file order, dotted keys joined, numbers with their source
+// text) and refuses what a matrix file cannot hold.
 
 namespace {
 
@@ -52,248 +56,221 @@ bool is_bare_key_char(char c) {
   return (c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '_' || c == '-';
 }
 
-class Parser {
- public:
-  Parser(const std::string& text, const std::string& file) : s_(text), file_(file) {}
+bool is_utf8_continuation(char c) { return (static_cast<unsigned char>(c) & 0xC0) == 0x80; }
 
-  MatrixFile parse() {
-    MatrixFile out;
-    out.name = file_;
-    out.text = s_;
-    std::map<std::string, int> defaults_seen;
-    while (true) {
-      skip_blank_lines();
-      if (eof()) break;
-      if (peek() == '[') {
-        out.sections.push_back(parse_header());
-        if (out.sections.back().kind == "defaults" && ++defaults_seen["defaults"] > 1)
-          throw MatrixError(out.sections.back().where, "[defaults] given more than once");
-        continue;
+// The source text addressed by toml++ positions: 1-based lines, columns in
+// code points, a UTF-8 byte order mark at the start not counted.
+class SourceText {
+ public:
+  SourceText(const std::string& text, const std::string& file) : s_(text), file_(file) {
+    const size_t start = s_.rfind("\xEF\xBB\xBF", 0) == 0 ? 3 : 0;
+    line_starts_.push_back(start);
+    for (size_t i = start; i < s_.size(); ++i)
+      if (s_[i] == '\n') line_starts_.push_back(i + 1);
+  }
+
+  SourceLocation at(const toml::source_position& p) const {
+    return {file_, std::max(int(p.line), 1), std::max(int(p.column), 1)};
+  }
+
+  // Byte offset of a position (the end of the text if it is beyond it).
+  size_t offset(const toml::source_position& p) const {
+    if (p.line < 1 || p.line > line_starts_.size()) return s_.size();
+    size_t i = line_starts_[p.line - 1];
+    for (toml::source_index c = 1; c < p.column && i < s_.size() && s_[i] != '\n'; ++c)
+      for (++i; i < s_.size() && is_utf8_continuation(s_[i]);) ++i;
+    return i;
+  }
+
+  std::string slice(const toml::source_region& r) const {
+    const size_t b = offset(r.begin), e = offset(r.end);
+    return e > b ? s_.substr(b, e - b) : std::string();
+  }
+
+  char char_at(const toml::source_position& p) const {
+    const size_t i = offset(p);
+    return i < s_.size() ? s_[i] : '\0';
+  }
+
+  // Where the key whose last part starts at `leaf` begins: back over the
+  // dotted key (parts, dots, blanks) to the line start, '{' or ','.
+  SourceLocation key_start(const toml::source_position& leaf) const {
+    if (leaf.line < 1 || leaf.line > line_starts_.size()) return at(leaf);
+    const size_t line_start = line_starts_[leaf.line - 1];
+    size_t j = offset(leaf);
+    while (j > line_start) {
+      const char c = s_[j - 1];
+      if (is_bare_key_char(c) || c == '.' || c == ' ' || c == '\t') {
+        --j;
+      } else if ((c == '"' || c == '\'') && j - 1 > line_start) {  // a quoted part
+        const size_t open = s_.rfind(c, j - 2);
+        if (open == std::string::npos || open < line_start) break;
+        j = open;
+      } else {
+        break;
       }
-      if (out.sections.empty())
-        throw MatrixError(here(), "key outside a section: start the file with [defaults] or [[sweep]]");
-      parse_entry(out.sections.back());
     }
+    while (j < s_.size() && (s_[j] == ' ' || s_[j] == '\t')) ++j;
+    int column = 1;
+    for (size_t i = line_start; i < j; ++i) column += !is_utf8_continuation(s_[i]);
+    return {file_, int(leaf.line), column};
+  }
+
+  // The word at a position (up to a blank, ',', ']', '}' or '#').
+  std::string word_at(const toml::source_position& p) const {
+    std::string w;
+    for (size_t i = offset(p); i < s_.size() && w.size() < 40; ++i) {
+      if (std::string_view(" \t\r\n,]}#").find(s_[i]) != std::string_view::npos) break;
+      w += s_[i];
+    }
+    return w;
+  }
+
+ private:
+  const std::string& s_;
+  std::string file_;
+  std::vector<size_t> line_starts_;
+};
+
+// Children of a table in file order (toml++ keeps them sorted by key).
+std::vector<std::pair<const toml::key*, const toml::node*>> in_file_order(const toml::table& t) {
+  std::vector<std::pair<const toml::key*, const toml::node*>> out;
+  for (const auto& [k, v] : t) out.emplace_back(&k, &v);
+  std::stable_sort(out.begin(), out.end(), [](const auto& a, const auto& b) {
+    const auto &pa = a.first->source().begin, &pb = b.first->source().begin;
+    return std::make_pair(pa.line, pa.column) < std::make_pair(pb.line, pb.column);
+  });
+  return out;
+}
+
+bool before(const SourceLocation& a, const SourceLocation& b) {
+  return std::make_pair(a.line, a.column) < std::make_pair(b.line, b.column);
+}
+
+// toml++'s tree -> MatrixFile.
+class TreeReader {
+ public:
+  explicit TreeReader(const SourceText& src) : src_(src) {}
+
+  std::vector<MatrixSection> sections(const toml::table& root) const {
+    std::vector<MatrixSection> out;
+    for (const auto& [key, node] : in_file_order(root)) {
+      const SourceLocation key_at = src_.at(key->source().begin);
+      // Written as [name] or [[name]] (not a dotted key or an inline table).
+      const bool header = src_.char_at(node->source().begin) == '[' &&
+                          (node->is_table() || (node->is_array_of_tables() &&
+                                                src_.char_at(node->as_array()->front().source().begin) == '['));
+      if (key->str() == "defaults" && node->is_table()) {
+        out.push_back(section("defaults", *node->as_table()));
+      } else if (key->str() == "sweep" && node->is_array_of_tables()) {
+        for (const toml::node& t : *node->as_array()) out.push_back(section("sweep", *t.as_table()));
+      } else if (key->str() == "sweep" && header) {
+        throw MatrixError(key_at, "a sweep is an array of tables: write [[sweep]]");
+      } else if (key->str() == "defaults" && node->is_array_of_tables()) {
+        throw MatrixError(key_at, "[defaults] is one table: write [defaults], not [[defaults]]");
+      } else if (header) {
+        throw MatrixError(key_at, "unknown section '" + std::string(key->str()) + "' (known: [defaults], [[sweep]])");
+      } else {
+        throw MatrixError(src_.key_start(key->source().begin),
+                          "key outside a section: start the file with [defaults] or [[sweep]]");
+      }
+    }
+    std::stable_sort(out.begin(), out.end(),
+                     [](const MatrixSection& a, const MatrixSection& b) { return before(a.where, b.where); });
     return out;
   }
 
  private:
-  bool eof() const { return pos_ >= s_.size(); }
-  char peek(size_t ahead = 0) const { return pos_ + ahead < s_.size() ? s_[pos_ + ahead] : '\0'; }
-  SourceLocation here() const { return {file_, line_, col_}; }
-  void advance() {
-    if (s_[pos_] == '\n') {
-      ++line_;
-      col_ = 1;
-    } else {
-      ++col_;
-    }
-    ++pos_;
-  }
-  void skip_spaces() {
-    while (!eof() && (peek() == ' ' || peek() == '\t' || peek() == '\r')) advance();
-  }
-  void skip_comment() {
-    if (peek() == '#')
-      while (!eof() && peek() != '\n') advance();
-  }
-  // Whitespace, comments and newlines.
-  void skip_blank_lines() {
-    while (!eof()) {
-      skip_spaces();
-      skip_comment();
-      if (peek() == '\n') {
-        advance();
-        continue;
-      }
-      break;
-    }
-  }
-  // After a header or an entry: only a comment may follow on the line.
-  void expect_line_end(const char* after) {
-    skip_spaces();
-    skip_comment();
-    if (eof()) return;
-    if (peek() != '\n') throw MatrixError(here(), std::string("unexpected '") + peek() + "' after " + after);
-    advance();
-  }
-
-  MatrixSection parse_header() {
+  MatrixSection section(const std::string& kind, const toml::table& t) const {
     MatrixSection sec;
-    sec.where = here();
-    advance();  // '['
-    const bool array = peek() == '[';
-    if (array) advance();
-    skip_spaces();
-    const SourceLocation name_at = here();
-    std::string name;
-    while (!eof() && is_bare_key_char(peek())) {
-      name += peek();
-      advance();
-    }
-    skip_spaces();
-    if (peek() != ']' || (array && peek(1) != ']'))
-      throw MatrixError(here(), array ? "expected ']]' to close the [[...]] header" : "expected ']' to close the [...] header");
-    advance();
-    if (array) advance();
-    if (array && name == "sweep") {
-      sec.kind = "sweep";
-    } else if (!array && name == "defaults") {
-      sec.kind = "defaults";
-    } else if (!array && name == "sweep") {
-      throw MatrixError(name_at, "a sweep is an array of tables: write [[sweep]]");
-    } else {
-      throw MatrixError(name_at, "unknown section '" + name + "' (known: [defaults], [[sweep]])");
-    }
-    expect_line_end("the section header");
+    sec.kind = kind;
+    sec.where = src_.at(t.source().begin);
+    add_entries(t, "", sec);
+    std::stable_sort(sec.entries.begin(), sec.entries.end(),
+                     [](const MatrixEntry& a, const MatrixEntry& b) { return before(a.where, b.where); });
     return sec;
   }
 
-  void parse_entry(MatrixSection& sec) {
-    MatrixEntry e;
-    e.where = here();
-    while (true) {
-      skip_spaces();
-      const SourceLocation part_at = here();
-      std::string part;
-      while (!eof() && is_bare_key_char(peek())) {
-        part += peek();
-        advance();
-      }
-      if (part.empty()) {
-        if (eof() || peek() == '\n') throw MatrixError(part_at, "expected a key");
-        throw MatrixError(part_at, std::string("unexpected '") + peek() + "': expected a key (letters, digits, '_', '-')");
-      }
-      e.key += (e.key.empty() ? "" : ".") + part;
-      skip_spaces();
-      if (peek() == '.') {
-        advance();
+  // Every value under `t`, nested tables (dotted keys, sub-tables) walked.
+  void add_entries(const toml::table& t, const std::string& prefix, MatrixSection& sec) const {
+    for (const auto& [key, node] : in_file_order(t)) {
+      const std::string part(key->str());
+      const std::string full = prefix.empty() ? part : prefix + "." + part;
+      if (part.empty() || !std::all_of(part.begin(), part.end(), is_bare_key_char))
+        throw MatrixError(src_.at(key->source().begin),
+                          "key '" + full + "': a key part is letters, digits, '_' and '-' only");
+      if (const toml::table* sub = node->as_table()) {
+        if (sub->empty()) throw MatrixError(src_.at(key->source().begin), "'" + full + "': empty table");
+        add_entries(*sub, full, sec);
         continue;
       }
-      break;
+      MatrixEntry e;
+      e.key = full;
+      e.where = src_.key_start(key->source().begin);
+      e.value = value(*node, full, false);
+      sec.entries.push_back(std::move(e));
     }
-    if (peek() != '=') throw MatrixError(here(), "expected '=' after key '" + e.key + "'");
-    advance();
-    skip_spaces();
-    e.value = parse_value(false);
-    for (const auto& prev : sec.entries)
-      if (prev.key == e.key)
-        throw MatrixError(e.where, "duplicate key '" + e.key + "' (first given at line " +
-                                       std::to_string(prev.where.line) + ")");
-    expect_line_end("the value");
-    sec.entries.push_back(std::move(e));
   }
 
-  MatrixValue parse_value(bool in_array) {
+  MatrixValue value(const toml::node& n, const std::string& key, bool in_array) const {
     MatrixValue v;
-    v.where = here();
-    if (eof() || peek() == '\n' || peek() == '#') throw MatrixError(here(), "expected a value");
-    const char c = peek();
-    if (c == '"' || c == '\'') {
+    v.where = src_.at(n.source().begin);
+    if (const auto* s = n.as_string()) {
       v.kind = MatrixValue::Kind::kString;
-      v.text = parse_string();
-      return v;
-    }
-    if (c == '[') {
-      if (in_array) throw MatrixError(here(), "nested arrays are not supported");
-      v.kind = MatrixValue::Kind::kArray;
-      advance();
-      while (true) {
-        skip_blank_lines();
-        if (eof()) throw MatrixError(v.where, "unterminated array: missing ']'");
-        if (peek() == ']') {
-          advance();
-          break;
-        }
-        v.items.push_back(parse_value(true));
-        if (v.items.size() > 1 && v.items.back().kind != v.items.front().kind)
-          throw MatrixError(v.items.back().where, "mixed types in an array");
-        skip_blank_lines();
-        if (peek() == ',') {
-          advance();
-          continue;
-        }
-        if (peek() == ']') {
-          advance();
-          break;
-        }
-        if (eof()) throw MatrixError(v.where, "unterminated array: missing ']'");
-        throw MatrixError(here(), std::string("expected ',' or ']' in array, found '") + peek() + "'");
-      }
-      return v;
-    }
-    // A bare token: number or boolean.
-    std::string token;
-    while (!eof() && (is_bare_key_char(peek()) || peek() == '.' || peek() == '+')) {
-      token += peek();
-      advance();
-    }
-    if (token.empty()) throw MatrixError(v.where, std::string("unexpected '") + c + "': expected a value");
-    if (token == "true" || token == "false") {
+      v.text = s->get();
+    } else if (n.is_integer() || n.is_floating_point()) {
+      v.kind = MatrixValue::Kind::kNumber;
+      v.text = src_.slice(n.source());
+      v.number = n.is_integer() ? double(n.as_integer()->get()) : n.as_floating_point()->get();
+      if (!std::isfinite(v.number)) throw MatrixError(v.where, "'" + v.text + "' is not a finite number");
+    } else if (const auto* b = n.as_boolean()) {
       v.kind = MatrixValue::Kind::kBool;
-      v.boolean = token == "true";
-      return v;
+      v.boolean = b->get();
+    } else if (const auto* a = n.as_array()) {
+      if (in_array) throw MatrixError(v.where, key + ": nested arrays are not supported");
+      v.kind = MatrixValue::Kind::kArray;
+      for (const toml::node& item : *a) v.items.push_back(value(item, key, true));
+    } else if (n.is_table()) {
+      throw MatrixError(v.where, key + ": a table is not a value here (arrays hold numbers, strings or true/false)");
+    } else {
+      throw MatrixError(v.where, key + ": dates and times are not values of a matrix file (strings are quoted)");
     }
-    std::string digits;  // TOML allows '_' between digits
-    for (char d : token)
-      if (d != '_') digits += d;
-    char* end = nullptr;
-    errno = 0;
-    const double x = std::strtod(digits.c_str(), &end);
-    const bool numeric_start = std::isdigit(static_cast<unsigned char>(digits[0])) || digits[0] == '+' ||
-                               digits[0] == '-' || digits[0] == '.';
-    if (end == digits.c_str() + digits.size() && !std::isfinite(x))
-      throw MatrixError(v.where, "'" + token + "' is not a finite number");
-    if (!numeric_start || end != digits.c_str() + digits.size())
-      throw MatrixError(v.where, "'" + token + "' is not a number, true/false, array or string (strings are "
-                                 "quoted: \"" + token + "\")");
-    if (!std::isfinite(x) || errno == ERANGE) throw MatrixError(v.where, "'" + token + "' is not a finite number");
-    v.kind = MatrixValue::Kind::kNumber;
-    v.number = x;
-    v.text = token;
     return v;
   }
 
-  std::string parse_string() {
-    const SourceLocation start = here();
-    const char quote = peek();
-    advance();
-    std::string out;
-    while (true) {
-      if (eof() || peek() == '\n') throw MatrixError(start, "unterminated string");
-      const char c = peek();
-      if (c == quote) {
-        advance();
-        return out;
-      }
-      if (c == '\\' && quote == '"') {
-        const SourceLocation esc = here();
-        advance();
-        switch (eof() ? '\0' : peek()) {
-          case '"': out += '"'; break;
-          case '\\': out += '\\'; break;
-          case 'n': out += '\n'; break;
-          case 't': out += '\t'; break;
-          default: throw MatrixError(esc, "unknown escape in string (known: \\\" \\\\ \\n \\t)");
-        }
-        advance();
-        continue;
-      }
-      out += c;
-      advance();
-    }
-  }
-
-  const std::string& s_;
-  std::string file_;
-  size_t pos_ = 0;
-  int line_ = 1, col_ = 1;
+  const SourceText& src_;
 };
+
+// toml++'s description of a syntax error, with a hint where it is terse.
+std::string syntax_error_message(const toml::parse_error& e, const SourceText& src) {
+  std::string what(e.description());
+  const auto has = [&](const char* part) { return what.find(part) != std::string::npos; };
+  const char at = src.char_at(e.source().begin);
+  const std::string word = src.word_at(e.source().begin);
+  if (has("could not determine value type") && !word.empty())  // a bare word
+    return "'" + word + "' is not a number, true/false, array or string (strings are quoted: \"" + word + "\")";
+  if (has("parsing string") && (at == '\n' || at == '\r' || at == '\0'))
+    what += " (unterminated string: missing its closing quote on this line)";
+  else if (has("parsing array") && has("end-of-file"))
+    what += " (unterminated array: missing ']')";
+  return what;
+}
 
 }  // namespace
 
 MatrixFile parse_matrix(const std::string& text, const std::string& file_name) {
-  return Parser(text, file_name).parse();
+  MatrixFile out;
+  out.name = file_name;
+  out.text = text;
+  const SourceText src(out.text, file_name);
+  toml::table root;
+  try {
+    root = toml::parse(std::string_view(out.text), std::string_view(file_name));
+  } catch (const toml::parse_error& e) {
+    throw MatrixError(src.at(e.source().begin), syntax_error_message(e, src));
+  }
+  out.sections = TreeReader(src).sections(root);
+  return out;
 }
 
 MatrixFile read_matrix_file(const std::string& path) {
