@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -241,6 +242,61 @@ class TreeReader {
   const SourceText& src_;
 };
 
+// toml++ 3.3.0 reaches __builtin_unreachable (undefined behaviour) when it
+// asks whether some non-ASCII characters are whitespace: outside strings and
+// comments, and first after a line-ending backslash in a """ string
+// (marzer/tomlplusplus issues 190 and 295). TOML allows non-ASCII only in
+// strings and comments, so this refuses, before toml++ sees the text, what
+// it would refuse anyway, plus the one valid case.
+void refuse_unsafe_non_ascii(const std::string& s, const std::string& file) {
+  enum class In { kCode, kComment, kBasic, kLiteral, kMultiBasic, kMultiLiteral } in = In::kCode;
+  int line = 1, column = 1;
+  size_t i = s.rfind("\xEF\xBB\xBF", 0) == 0 ? 3 : 0;
+  auto starts = [&](const char* t) { return s.compare(i, std::strlen(t), t) == 0; };
+  auto advance = [&](size_t n) {
+    for (; n > 0 && i < s.size(); --n, ++i) {
+      if (s[i] == '\n') {
+        ++line;
+        column = 1;
+      } else if (!is_utf8_continuation(s[i])) {
+        ++column;
+      }
+    }
+  };
+  const auto refuse = [&](const std::string& what) { throw MatrixError({file, line, column}, what); };
+  while (i < s.size()) {
+    const char c = s[i];
+    if (in == In::kCode) {
+      if (static_cast<unsigned char>(c) >= 0x80)
+        refuse("non-ASCII character outside a string or comment (TOML allows them only there)");
+      if (c == '#') in = In::kComment;
+      if (c == '"') in = starts("\"\"\"") ? (advance(2), In::kMultiBasic) : In::kBasic;
+      if (c == '\'') in = starts("\'\'\'") ? (advance(2), In::kMultiLiteral) : In::kLiteral;
+    } else if (c == '\n' && in != In::kMultiBasic && in != In::kMultiLiteral) {
+      in = In::kCode;  // end of a comment (or of an unterminated string: toml++ says so)
+    } else if ((in == In::kBasic && c == '"') || (in == In::kLiteral && c == '\'')) {
+      in = In::kCode;
+    } else if ((in == In::kMultiBasic && starts("\"\"\"")) || (in == In::kMultiLiteral && starts("\'\'\'"))) {
+      advance(2);
+      while (i + 1 < s.size() && s[i + 1] == c) advance(1);  // up to two quotes belong to the string
+      in = In::kCode;
+    } else if ((in == In::kBasic || in == In::kMultiBasic) && c == '\\') {
+      size_t j = i + 1;  // a line-ending backslash: blanks, newline, then whitespace is skipped
+      while (in == In::kMultiBasic && j < s.size() && (s[j] == ' ' || s[j] == '\t' || s[j] == '\r')) ++j;
+      if (in == In::kMultiBasic && j < s.size() && s[j] == '\n') {
+        while (j < s.size() && std::string_view(" \t\r\n").find(s[j]) != std::string_view::npos) ++j;
+        advance(j - i);
+        if (i < s.size() && static_cast<unsigned char>(s[i]) >= 0x80)
+          refuse("non-ASCII character first after a line-ending backslash: toml++ 3.3 cannot read it "
+                 "(put an ASCII character before it)");
+        continue;
+      }
+      advance(1);  // the escaped character is skipped below
+    }
+    advance(1);
+  }
+}
+
 // toml++'s description of a syntax error, with a hint where it is terse.
 std::string syntax_error_message(const toml::parse_error& e, const SourceText& src) {
   std::string what(e.description());
@@ -263,6 +319,7 @@ MatrixFile parse_matrix(const std::string& text, const std::string& file_name) {
   out.name = file_name;
   out.text = text;
   const SourceText src(out.text, file_name);
+  refuse_unsafe_non_ascii(out.text, file_name);
   toml::table root;
   try {
     root = toml::parse(std::string_view(out.text), std::string_view(file_name));

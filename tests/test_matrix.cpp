@@ -225,6 +225,31 @@ TEST(MatrixParse, AcceptsAByteOrderMark) {
   EXPECT_EQ(error_of("\xEF\xBB\xBF\xEF\xBB\xBF[[sweep]]\n").substr(0, 9), "m.toml:1:");
 }
 
+// Non-ASCII characters: in strings and comments as TOML allows; elsewhere
+// refused before toml++ 3.3 sees them (it has undefined behaviour there).
+TEST(MatrixParse, NonAsciiOnlyInStringsAndComments) {
+  const MatrixFile f = parse_matrix("# Straße\n[[sweep]]\nname = \"Zürich\"  # é\nproblems = 'ü'\nx = \"\"\"ß\n\"\"\"\n",
+                                    "u.toml");
+  ASSERT_EQ(f.sections.at(0).entries.size(), 3u);
+  EXPECT_EQ(f.sections[0].entries[0].value.text, "Zürich");
+  EXPECT_EQ(f.sections[0].entries[2].value.text, "ß\n");
+  EXPECT_NE(error_of("[[sweep]]\nname = \"Zürich\"\n\"é\" = 1\n").find("m.toml:3:1: key 'é': a key part is"),
+            std::string::npos);
+  const std::string outside = "non-ASCII character outside a string or comment";
+  for (const auto& [text, where] : std::vector<std::pair<std::string, std::string>>{
+           {"[[sweep]]\né = 1\n", "m.toml:2:1: "},
+           {"[[sweep]]\nstep = 1é\n", "m.toml:2:9: "},
+           {"[[sweep]]\nname = \"ü\" é\n", "m.toml:2:12: "},
+           {"[[sweep]]\nstep = [1, \xC2\xA0 2]\n", "m.toml:2:12: "}}) {
+    SCOPED_TRACE(text);
+    EXPECT_EQ(error_of(text).substr(0, where.size()), where) << error_of(text);
+    EXPECT_NE(error_of(text).find(outside), std::string::npos) << error_of(text);
+  }
+  const std::string after_backslash = error_of("[[sweep]]\nname = \"\"\"a\\\n   \xC2\xA7\"\"\"\n");
+  EXPECT_EQ(after_backslash.substr(0, 12), "m.toml:3:4: ") << after_backslash;
+  EXPECT_NE(after_backslash.find("line-ending backslash"), std::string::npos) << after_backslash;
+}
+
 // The same parameter keys in every TOML spelling give the same cases; a
 // key's location is where it starts on its line.
 TEST(MatrixParse, DottedKeysInAnyTomlSpelling) {
