@@ -242,15 +242,19 @@ class TreeReader {
   const SourceText& src_;
 };
 
-// toml++ 3.3.0 reaches __builtin_unreachable (undefined behaviour) when it
-// asks whether some non-ASCII characters are whitespace: outside strings and
-// comments, and first after a line-ending backslash in a """ string
-// (marzer/tomlplusplus issues 190 and 295). TOML allows non-ASCII only in
-// strings and comments, so this refuses, before toml++ sees the text, what
-// it would refuse anyway, plus the one valid case.
-void refuse_unsafe_non_ascii(const std::string& s, const std::string& file) {
+// Refuses, before toml++ 3.3.0 sees the text, what it mishandles:
+// - it reaches __builtin_unreachable (undefined behaviour) when it asks
+//   whether some non-ASCII characters are whitespace: outside strings and
+//   comments, and first after a line-ending backslash in a """ string
+//   (marzer/tomlplusplus issues 190 and 295). TOML allows non-ASCII only in
+//   strings and comments: this refuses what toml++ would refuse anyway, plus
+//   that one valid case;
+// - it recurses once per part of a dotted key (a stack overflow at some
+//   100 000 parts); a matrix key has at most three.
+void refuse_what_toml_mishandles(const std::string& s, const std::string& file) {
+  constexpr int kMaxDots = 64;  // in a row, outside strings and comments
   enum class In { kCode, kComment, kBasic, kLiteral, kMultiBasic, kMultiLiteral } in = In::kCode;
-  int line = 1, column = 1;
+  int line = 1, column = 1, dots = 0;
   size_t i = s.rfind("\xEF\xBB\xBF", 0) == 0 ? 3 : 0;
   auto starts = [&](const char* t) { return s.compare(i, std::strlen(t), t) == 0; };
   auto advance = [&](size_t n) {
@@ -269,6 +273,10 @@ void refuse_unsafe_non_ascii(const std::string& s, const std::string& file) {
     if (in == In::kCode) {
       if (static_cast<unsigned char>(c) >= 0x80)
         refuse("non-ASCII character outside a string or comment (TOML allows them only there)");
+      if (c == '.' && ++dots > kMaxDots)
+        refuse("more than " + std::to_string(kMaxDots) + " dots in a dotted key (a matrix key has at most three "
+               "parts: param.METHOD.NAME)");
+      if (!is_bare_key_char(c) && std::string_view(". \t\"'").find(c) == std::string_view::npos) dots = 0;
       if (c == '#') in = In::kComment;
       if (c == '"') in = starts("\"\"\"") ? (advance(2), In::kMultiBasic) : In::kBasic;
       if (c == '\'') in = starts("\'\'\'") ? (advance(2), In::kMultiLiteral) : In::kLiteral;
@@ -319,7 +327,7 @@ MatrixFile parse_matrix(const std::string& text, const std::string& file_name) {
   out.name = file_name;
   out.text = text;
   const SourceText src(out.text, file_name);
-  refuse_unsafe_non_ascii(out.text, file_name);
+  refuse_what_toml_mishandles(out.text, file_name);
   toml::table root;
   try {
     root = toml::parse(std::string_view(out.text), std::string_view(file_name));

@@ -250,6 +250,22 @@ TEST(MatrixParse, NonAsciiOnlyInStringsAndComments) {
   EXPECT_NE(after_backslash.find("line-ending backslash"), std::string::npos) << after_backslash;
 }
 
+// A dotted key of very many parts is refused before toml++ 3.3 (which
+// recurses once per part) overflows the stack; numbers and strings do not count.
+TEST(MatrixParse, DottedKeyOfManyPartsIsAnErrorNotACrash) {
+  std::string key = "p";
+  for (int i = 0; i < 200000; ++i) key += ".p";
+  const std::string e = error_of("[[sweep]]\n" + key + " = 1\n");
+  EXPECT_EQ(e.substr(0, 14), "m.toml:2:130: ") << e.substr(0, 200);
+  EXPECT_NE(e.find("more than 64 dots in a dotted key"), std::string::npos) << e.substr(0, 200);
+  std::string many = "[[sweep]]\nstep = [";
+  for (int i = 0; i < 200; ++i) many += "1.5, ";
+  many += "2.5]\nname = \"" + std::string(100, '.') + "\"\n";
+  const MatrixFile f = parse_matrix(many, "m.toml");
+  EXPECT_EQ(f.sections.at(0).entries.at(0).value.items.size(), 201u);
+  EXPECT_EQ(f.sections[0].entries.at(1).value.text, std::string(100, '.'));
+}
+
 // The same parameter keys in every TOML spelling give the same cases; a
 // key's location is where it starts on its line.
 TEST(MatrixParse, DottedKeysInAnyTomlSpelling) {
