@@ -60,26 +60,42 @@ bool is_bare_key_char(char c) {
 bool is_utf8_continuation(char c) { return (static_cast<unsigned char>(c) & 0xC0) == 0x80; }
 
 // The source text addressed by toml++ positions: 1-based lines, columns in
-// code points, a UTF-8 byte order mark at the start not counted.
+// code points, a UTF-8 byte order mark at the start not counted. Lookups are
+// O(1) on ASCII lines and resume from the last one on others (toml++ asks in
+// file order), so a line of 100 000 values stays linear.
 class SourceText {
  public:
   SourceText(const std::string& text, const std::string& file) : s_(text), file_(file) {
     const size_t start = s_.rfind("\xEF\xBB\xBF", 0) == 0 ? 3 : 0;
     line_starts_.push_back(start);
-    for (size_t i = start; i < s_.size(); ++i)
-      if (s_[i] == '\n') line_starts_.push_back(i + 1);
+    ascii_.push_back(true);
+    for (size_t i = start; i < s_.size(); ++i) {
+      if (s_[i] == '\n') {
+        line_starts_.push_back(i + 1);
+        ascii_.push_back(true);
+      } else if (static_cast<unsigned char>(s_[i]) >= 0x80) {
+        ascii_.back() = false;
+      }
+    }
   }
 
   SourceLocation at(const toml::source_position& p) const {
     return {file_, std::max(int(p.line), 1), std::max(int(p.column), 1)};
   }
 
-  // Byte offset of a position (the end of the text if it is beyond it).
+  // Byte offset of a position (the end of its line if the column is beyond
+  // it, the end of the text if the line is).
   size_t offset(const toml::source_position& p) const {
     if (p.line < 1 || p.line > line_starts_.size()) return s_.size();
-    size_t i = line_starts_[p.line - 1];
-    for (toml::source_index c = 1; c < p.column && i < s_.size() && s_[i] != '\n'; ++c)
-      for (++i; i < s_.size() && is_utf8_continuation(s_[i]);) ++i;
+    const size_t start = line_starts_[p.line - 1];
+    const size_t end = p.line < line_starts_.size() ? line_starts_[p.line] - 1 : s_.size();
+    const size_t column = std::max<size_t>(p.column, 1);
+    if (ascii_[p.line - 1]) return std::min(start + column - 1, end);
+    if (memo_.line != p.line || memo_.column > column) memo_ = {p.line, 1, start};
+    size_t c = memo_.column, i = memo_.offset;
+    for (; c < column && i < end; ++c)
+      for (++i; i < end && is_utf8_continuation(s_[i]);) ++i;
+    memo_ = {p.line, c, i};
     return i;
   }
 
@@ -98,7 +114,8 @@ class SourceText {
   SourceLocation key_start(const toml::source_position& leaf) const {
     if (leaf.line < 1 || leaf.line > line_starts_.size()) return at(leaf);
     const size_t line_start = line_starts_[leaf.line - 1];
-    size_t j = offset(leaf);
+    const size_t leaf_at = offset(leaf);
+    size_t j = leaf_at;
     while (j > line_start) {
       const char c = s_[j - 1];
       if (is_bare_key_char(c) || c == '.' || c == ' ' || c == '\t') {
@@ -112,9 +129,11 @@ class SourceText {
       }
     }
     while (j < s_.size() && (s_[j] == ' ' || s_[j] == '\t')) ++j;
-    int column = 1;
-    for (size_t i = line_start; i < j; ++i) column += !is_utf8_continuation(s_[i]);
-    return {file_, int(leaf.line), column};
+    // Only blanks, key parts and dots were passed: the column is the leaf's
+    // less the code points in between.
+    size_t between = 0;
+    for (size_t i = j; i < leaf_at; ++i) between += !is_utf8_continuation(s_[i]);
+    return {file_, int(leaf.line), int(leaf.column - between)};
   }
 
   // The word at a position (up to a blank, ',', ']', '}' or '#').
@@ -128,9 +147,15 @@ class SourceText {
   }
 
  private:
+  struct Memo {
+    toml::source_index line = 0;
+    size_t column = 1, offset = 0;  // `column` of `line` starts at byte `offset`
+  };
   const std::string& s_;
   std::string file_;
   std::vector<size_t> line_starts_;
+  std::vector<char> ascii_;  // per line: no byte >= 0x80 (columns are bytes)
+  mutable Memo memo_;
 };
 
 // Children of a table in file order (toml++ keeps them sorted by key).

@@ -245,6 +245,18 @@ TEST(MatrixParse, NonAsciiOnlyInStringsAndComments) {
     EXPECT_EQ(error_of(text).substr(0, where.size()), where) << error_of(text);
     EXPECT_NE(error_of(text).find(outside), std::string::npos) << error_of(text);
   }
+  // Positions and source text after non-ASCII characters on the same line.
+  const MatrixFile g = parse_matrix("[[sweep]]\nx = [\"ü\", \"éé\", 1_0, 2]  # ß\n", "u.toml");
+  const auto& items = g.sections.at(0).entries.at(0).value.items;
+  ASSERT_EQ(items.size(), 4u);
+  EXPECT_EQ(items[2].text, "1_0");
+  EXPECT_EQ(items[2].where.str(), "u.toml:2:17");
+  EXPECT_EQ(items[3].text, "2");
+  EXPECT_EQ(items[1].where.str(), "u.toml:2:11");
+  const MatrixFile h = parse_matrix("[[sweep]]\nparam = { s = \"ü\", x.y = 1 }\n", "u.toml");
+  ASSERT_EQ(h.sections.at(0).entries.size(), 2u);
+  EXPECT_EQ(h.sections[0].entries[1].key, "param.x.y");
+  EXPECT_EQ(h.sections[0].entries[1].where.str(), "u.toml:2:20");
   const std::string after_backslash = error_of("[[sweep]]\nname = \"\"\"a\\\n   \xC2\xA7\"\"\"\n");
   EXPECT_EQ(after_backslash.substr(0, 12), "m.toml:3:4: ") << after_backslash;
   EXPECT_NE(after_backslash.find("line-ending backslash"), std::string::npos) << after_backslash;
