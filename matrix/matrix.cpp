@@ -280,6 +280,7 @@ void refuse_what_toml_mishandles(const std::string& s, const std::string& file) 
   constexpr int kMaxDots = 64;  // in a row, outside strings and comments
   enum class In { kCode, kComment, kBasic, kLiteral, kMultiBasic, kMultiLiteral } in = In::kCode;
   int line = 1, column = 1, dots = 0;
+  char prev = '\n';  // the character before, in code
   size_t i = s.rfind("\xEF\xBB\xBF", 0) == 0 ? 3 : 0;
   auto starts = [&](const char* t) { return s.compare(i, std::strlen(t), t) == 0; };
   auto advance = [&](size_t n) {
@@ -302,17 +303,24 @@ void refuse_what_toml_mishandles(const std::string& s, const std::string& file) 
         refuse("more than " + std::to_string(kMaxDots) + " dots in a dotted key (a matrix key has at most three "
                "parts: param.METHOD.NAME)");
       if (!is_bare_key_char(c) && std::string_view(". \t\"'").find(c) == std::string_view::npos) dots = 0;
+      // A quote starts a string where a value or a key may start; within a
+      // bare word (`0xZ"..`) toml++ reads on to the next blank, ',' or ']'.
+      const bool token_start = std::string_view("\n\r \t=[{,").find(prev) != std::string_view::npos;
       if (c == '#') in = In::kComment;
-      if (c == '"') in = starts("\"\"\"") ? (advance(2), In::kMultiBasic) : In::kBasic;
-      if (c == '\'') in = starts("\'\'\'") ? (advance(2), In::kMultiLiteral) : In::kLiteral;
+      if (c == '"' && token_start) in = starts("\"\"\"") ? (advance(2), In::kMultiBasic) : In::kBasic;
+      if (c == '\'' && token_start) in = starts("\'\'\'") ? (advance(2), In::kMultiLiteral) : In::kLiteral;
+      prev = c;
     } else if (c == '\n' && in != In::kMultiBasic && in != In::kMultiLiteral) {
       in = In::kCode;  // end of a comment (or of an unterminated string: toml++ says so)
+      prev = c;
     } else if ((in == In::kBasic && c == '"') || (in == In::kLiteral && c == '\'')) {
       in = In::kCode;
+      prev = c;
     } else if ((in == In::kMultiBasic && starts("\"\"\"")) || (in == In::kMultiLiteral && starts("\'\'\'"))) {
       advance(2);
       while (i + 1 < s.size() && s[i + 1] == c) advance(1);  // up to two quotes belong to the string
       in = In::kCode;
+      prev = c;
     } else if ((in == In::kBasic || in == In::kMultiBasic) && c == '\\') {
       size_t j = i + 1;  // a line-ending backslash: blanks, newline, then whitespace is skipped
       while (in == In::kMultiBasic && j < s.size() && (s[j] == ' ' || s[j] == '\t' || s[j] == '\r')) ++j;

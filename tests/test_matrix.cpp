@@ -240,7 +240,8 @@ TEST(MatrixParse, NonAsciiOnlyInStringsAndComments) {
            {"[[sweep]]\né = 1\n", "m.toml:2:1: "},
            {"[[sweep]]\nstep = 1é\n", "m.toml:2:9: "},
            {"[[sweep]]\nname = \"ü\" é\n", "m.toml:2:12: "},
-           {"[[sweep]]\nstep = [1, \xC2\xA0 2]\n", "m.toml:2:12: "}}) {
+           {"[[sweep]]\nstep = [1, \xC2\xA0 2]\n", "m.toml:2:12: "},
+           {"[[sweep]]\nstep = [0xZ0\"a\xD2\x95" "b\"]\n", "m.toml:2:15: "}}) {  // a quote in a bare word
     SCOPED_TRACE(text);
     EXPECT_EQ(error_of(text).substr(0, where.size()), where) << error_of(text);
     EXPECT_NE(error_of(text).find(outside), std::string::npos) << error_of(text);
