@@ -1,12 +1,12 @@
-// Matrix files: parsing (a strict TOML subset) and deterministic expansion.
+// Matrix files: parsing (TOML, read by toml++) and deterministic expansion.
 #include "matrix/matrix.hpp"
 
 #include <algorithm>
-#include <cerrno>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -14,6 +14,9 @@
 #include <set>
 #include <sstream>
 #include <stdexcept>
+#include <string_view>
+
+#include <toml++/toml.h>
 
 #include "core/format.hpp"
 #include "harness/integrator.hpp"
@@ -34,7 +37,9 @@ std::string read_text_file(const std::string& path) {
 }
 
 // ===========================================================================
-// Parser
+// Parser: toml++ reads the TOML; this maps its tree onto MatrixFile (sections
+// and entries in file order, dotted keys joined, numbers with their source
+// text) and refuses what a matrix file cannot hold.
 
 namespace {
 
@@ -42,248 +47,318 @@ bool is_bare_key_char(char c) {
   return (c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '_' || c == '-';
 }
 
-class Parser {
- public:
-  Parser(const std::string& text, const std::string& file) : s_(text), file_(file) {}
+bool is_utf8_continuation(char c) { return (static_cast<unsigned char>(c) & 0xC0) == 0x80; }
 
-  MatrixFile parse() {
-    MatrixFile out;
-    out.name = file_;
-    out.text = s_;
-    std::map<std::string, int> defaults_seen;
-    while (true) {
-      skip_blank_lines();
-      if (eof()) break;
-      if (peek() == '[') {
-        out.sections.push_back(parse_header());
-        if (out.sections.back().kind == "defaults" && ++defaults_seen["defaults"] > 1)
-          throw MatrixError(out.sections.back().where, "[defaults] given more than once");
-        continue;
+// The source text addressed by toml++ positions: 1-based lines, columns in
+// code points, a UTF-8 byte order mark at the start not counted. Lookups are
+// O(1) on ASCII lines and resume from the last one on others (toml++ asks in
+// file order), so a line of 100 000 values stays linear.
+class SourceText {
+ public:
+  SourceText(const std::string& text, const std::string& file) : s_(text), file_(file) {
+    const size_t start = s_.rfind("\xEF\xBB\xBF", 0) == 0 ? 3 : 0;
+    line_starts_.push_back(start);
+    ascii_.push_back(true);
+    for (size_t i = start; i < s_.size(); ++i) {
+      if (s_[i] == '\n') {
+        line_starts_.push_back(i + 1);
+        ascii_.push_back(true);
+      } else if (static_cast<unsigned char>(s_[i]) >= 0x80) {
+        ascii_.back() = false;
       }
-      if (out.sections.empty())
-        throw MatrixError(here(), "key outside a section: start the file with [defaults] or [[sweep]]");
-      parse_entry(out.sections.back());
     }
+  }
+
+  SourceLocation at(const toml::source_position& p) const {
+    return {file_, std::max(int(p.line), 1), std::max(int(p.column), 1)};
+  }
+
+  // Byte offset of a position (the end of its line if the column is beyond
+  // it, the end of the text if the line is).
+  size_t offset(const toml::source_position& p) const {
+    if (p.line < 1 || p.line > line_starts_.size()) return s_.size();
+    const size_t start = line_starts_[p.line - 1];
+    const size_t end = p.line < line_starts_.size() ? line_starts_[p.line] - 1 : s_.size();
+    const size_t column = std::max<size_t>(p.column, 1);
+    if (ascii_[p.line - 1]) return std::min(start + column - 1, end);
+    if (memo_.line != p.line || memo_.column > column) memo_ = {p.line, 1, start};
+    size_t c = memo_.column, i = memo_.offset;
+    for (; c < column && i < end; ++c)
+      for (++i; i < end && is_utf8_continuation(s_[i]);) ++i;
+    memo_ = {p.line, c, i};
+    return i;
+  }
+
+  std::string slice(const toml::source_region& r) const {
+    const size_t b = offset(r.begin), e = offset(r.end);
+    return e > b ? s_.substr(b, e - b) : std::string();
+  }
+
+  char char_at(const toml::source_position& p) const {
+    const size_t i = offset(p);
+    return i < s_.size() ? s_[i] : '\0';
+  }
+
+  // Where the key whose last part starts at `leaf` begins: back over the
+  // dotted key (parts, dots, blanks) to the line start, '{' or ','.
+  SourceLocation key_start(const toml::source_position& leaf) const {
+    if (leaf.line < 1 || leaf.line > line_starts_.size()) return at(leaf);
+    const size_t line_start = line_starts_[leaf.line - 1];
+    const size_t leaf_at = offset(leaf);
+    size_t j = leaf_at;
+    while (j > line_start) {
+      const char c = s_[j - 1];
+      if (is_bare_key_char(c) || c == '.' || c == ' ' || c == '\t') {
+        --j;
+      } else if ((c == '"' || c == '\'') && j - 1 > line_start) {  // a quoted part
+        const size_t open = s_.rfind(c, j - 2);
+        if (open == std::string::npos || open < line_start) break;
+        j = open;
+      } else {
+        break;
+      }
+    }
+    while (j < s_.size() && (s_[j] == ' ' || s_[j] == '\t')) ++j;
+    // Only blanks, key parts and dots were passed: the column is the leaf's
+    // less the code points in between.
+    size_t between = 0;
+    for (size_t i = j; i < leaf_at; ++i) between += !is_utf8_continuation(s_[i]);
+    return {file_, int(leaf.line), int(leaf.column - between)};
+  }
+
+  // The word at a position (up to a blank, ',', ']', '}' or '#').
+  std::string word_at(const toml::source_position& p) const {
+    std::string w;
+    for (size_t i = offset(p); i < s_.size() && w.size() < 40; ++i) {
+      if (std::string_view(" \t\r\n,]}#").find(s_[i]) != std::string_view::npos) break;
+      w += s_[i];
+    }
+    return w;
+  }
+
+ private:
+  struct Memo {
+    toml::source_index line = 0;
+    size_t column = 1, offset = 0;  // `column` of `line` starts at byte `offset`
+  };
+  const std::string& s_;
+  std::string file_;
+  std::vector<size_t> line_starts_;
+  std::vector<char> ascii_;  // per line: no byte >= 0x80 (columns are bytes)
+  mutable Memo memo_;
+};
+
+// Children of a table in file order (toml++ keeps them sorted by key).
+std::vector<std::pair<const toml::key*, const toml::node*>> in_file_order(const toml::table& t) {
+  std::vector<std::pair<const toml::key*, const toml::node*>> out;
+  for (const auto& [k, v] : t) out.emplace_back(&k, &v);
+  std::stable_sort(out.begin(), out.end(), [](const auto& a, const auto& b) {
+    const auto &pa = a.first->source().begin, &pb = b.first->source().begin;
+    return std::make_pair(pa.line, pa.column) < std::make_pair(pb.line, pb.column);
+  });
+  return out;
+}
+
+bool before(const SourceLocation& a, const SourceLocation& b) {
+  return std::make_pair(a.line, a.column) < std::make_pair(b.line, b.column);
+}
+
+// toml++'s tree -> MatrixFile.
+class TreeReader {
+ public:
+  explicit TreeReader(const SourceText& src) : src_(src) {}
+
+  std::vector<MatrixSection> sections(const toml::table& root) const {
+    std::vector<MatrixSection> out;
+    for (const auto& [key, node] : in_file_order(root)) {
+      const SourceLocation key_at = src_.at(key->source().begin);
+      // Written as [name] or [[name]] (not a dotted key or an inline table).
+      const bool header = src_.char_at(node->source().begin) == '[' &&
+                          (node->is_table() || (node->is_array_of_tables() &&
+                                                src_.char_at(node->as_array()->front().source().begin) == '['));
+      if (key->str() == "defaults" && node->is_table()) {
+        out.push_back(section("defaults", *node->as_table()));
+      } else if (key->str() == "sweep" && node->is_array_of_tables()) {
+        for (const toml::node& t : *node->as_array()) out.push_back(section("sweep", *t.as_table()));
+      } else if (key->str() == "sweep" && header) {
+        throw MatrixError(key_at, "a sweep is an array of tables: write [[sweep]]");
+      } else if (key->str() == "defaults" && node->is_array_of_tables()) {
+        throw MatrixError(key_at, "[defaults] is one table: write [defaults], not [[defaults]]");
+      } else if (header) {
+        throw MatrixError(key_at, "unknown section '" + std::string(key->str()) + "' (known: [defaults], [[sweep]])");
+      } else {
+        throw MatrixError(src_.key_start(key->source().begin),
+                          "key outside a section: start the file with [defaults] or [[sweep]]");
+      }
+    }
+    std::stable_sort(out.begin(), out.end(),
+                     [](const MatrixSection& a, const MatrixSection& b) { return before(a.where, b.where); });
     return out;
   }
 
  private:
-  bool eof() const { return pos_ >= s_.size(); }
-  char peek(size_t ahead = 0) const { return pos_ + ahead < s_.size() ? s_[pos_ + ahead] : '\0'; }
-  SourceLocation here() const { return {file_, line_, col_}; }
-  void advance() {
-    if (s_[pos_] == '\n') {
-      ++line_;
-      col_ = 1;
-    } else {
-      ++col_;
-    }
-    ++pos_;
-  }
-  void skip_spaces() {
-    while (!eof() && (peek() == ' ' || peek() == '\t' || peek() == '\r')) advance();
-  }
-  void skip_comment() {
-    if (peek() == '#')
-      while (!eof() && peek() != '\n') advance();
-  }
-  // Whitespace, comments and newlines.
-  void skip_blank_lines() {
-    while (!eof()) {
-      skip_spaces();
-      skip_comment();
-      if (peek() == '\n') {
-        advance();
-        continue;
-      }
-      break;
-    }
-  }
-  // After a header or an entry: only a comment may follow on the line.
-  void expect_line_end(const char* after) {
-    skip_spaces();
-    skip_comment();
-    if (eof()) return;
-    if (peek() != '\n') throw MatrixError(here(), std::string("unexpected '") + peek() + "' after " + after);
-    advance();
-  }
-
-  MatrixSection parse_header() {
+  MatrixSection section(const std::string& kind, const toml::table& t) const {
     MatrixSection sec;
-    sec.where = here();
-    advance();  // '['
-    const bool array = peek() == '[';
-    if (array) advance();
-    skip_spaces();
-    const SourceLocation name_at = here();
-    std::string name;
-    while (!eof() && is_bare_key_char(peek())) {
-      name += peek();
-      advance();
-    }
-    skip_spaces();
-    if (peek() != ']' || (array && peek(1) != ']'))
-      throw MatrixError(here(), array ? "expected ']]' to close the [[...]] header" : "expected ']' to close the [...] header");
-    advance();
-    if (array) advance();
-    if (array && name == "sweep") {
-      sec.kind = "sweep";
-    } else if (!array && name == "defaults") {
-      sec.kind = "defaults";
-    } else if (!array && name == "sweep") {
-      throw MatrixError(name_at, "a sweep is an array of tables: write [[sweep]]");
-    } else {
-      throw MatrixError(name_at, "unknown section '" + name + "' (known: [defaults], [[sweep]])");
-    }
-    expect_line_end("the section header");
+    sec.kind = kind;
+    sec.where = src_.at(t.source().begin);
+    add_entries(t, "", sec);
+    std::stable_sort(sec.entries.begin(), sec.entries.end(),
+                     [](const MatrixEntry& a, const MatrixEntry& b) { return before(a.where, b.where); });
     return sec;
   }
 
-  void parse_entry(MatrixSection& sec) {
-    MatrixEntry e;
-    e.where = here();
-    while (true) {
-      skip_spaces();
-      const SourceLocation part_at = here();
-      std::string part;
-      while (!eof() && is_bare_key_char(peek())) {
-        part += peek();
-        advance();
-      }
-      if (part.empty()) {
-        if (eof() || peek() == '\n') throw MatrixError(part_at, "expected a key");
-        throw MatrixError(part_at, std::string("unexpected '") + peek() + "': expected a key (letters, digits, '_', '-')");
-      }
-      e.key += (e.key.empty() ? "" : ".") + part;
-      skip_spaces();
-      if (peek() == '.') {
-        advance();
+  // Every value under `t`, nested tables (dotted keys, sub-tables) walked.
+  void add_entries(const toml::table& t, const std::string& prefix, MatrixSection& sec) const {
+    for (const auto& [key, node] : in_file_order(t)) {
+      const std::string part(key->str());
+      const std::string full = prefix.empty() ? part : prefix + "." + part;
+      if (part.empty() || !std::all_of(part.begin(), part.end(), is_bare_key_char))
+        throw MatrixError(src_.at(key->source().begin),
+                          "key '" + full + "': a key part is letters, digits, '_' and '-' only");
+      if (const toml::table* sub = node->as_table()) {
+        if (sub->empty()) throw MatrixError(src_.at(key->source().begin), "'" + full + "': empty table");
+        add_entries(*sub, full, sec);
         continue;
       }
-      break;
+      MatrixEntry e;
+      e.key = full;
+      e.where = src_.key_start(key->source().begin);
+      e.value = value(*node, full, false);
+      sec.entries.push_back(std::move(e));
     }
-    if (peek() != '=') throw MatrixError(here(), "expected '=' after key '" + e.key + "'");
-    advance();
-    skip_spaces();
-    e.value = parse_value(false);
-    for (const auto& prev : sec.entries)
-      if (prev.key == e.key)
-        throw MatrixError(e.where, "duplicate key '" + e.key + "' (first given at line " +
-                                       std::to_string(prev.where.line) + ")");
-    expect_line_end("the value");
-    sec.entries.push_back(std::move(e));
   }
 
-  MatrixValue parse_value(bool in_array) {
+  MatrixValue value(const toml::node& n, const std::string& key, bool in_array) const {
     MatrixValue v;
-    v.where = here();
-    if (eof() || peek() == '\n' || peek() == '#') throw MatrixError(here(), "expected a value");
-    const char c = peek();
-    if (c == '"' || c == '\'') {
+    v.where = src_.at(n.source().begin);
+    if (const auto* s = n.as_string()) {
       v.kind = MatrixValue::Kind::kString;
-      v.text = parse_string();
-      return v;
-    }
-    if (c == '[') {
-      if (in_array) throw MatrixError(here(), "nested arrays are not supported");
-      v.kind = MatrixValue::Kind::kArray;
-      advance();
-      while (true) {
-        skip_blank_lines();
-        if (eof()) throw MatrixError(v.where, "unterminated array: missing ']'");
-        if (peek() == ']') {
-          advance();
-          break;
-        }
-        v.items.push_back(parse_value(true));
-        if (v.items.size() > 1 && v.items.back().kind != v.items.front().kind)
-          throw MatrixError(v.items.back().where, "mixed types in an array");
-        skip_blank_lines();
-        if (peek() == ',') {
-          advance();
-          continue;
-        }
-        if (peek() == ']') {
-          advance();
-          break;
-        }
-        if (eof()) throw MatrixError(v.where, "unterminated array: missing ']'");
-        throw MatrixError(here(), std::string("expected ',' or ']' in array, found '") + peek() + "'");
-      }
-      return v;
-    }
-    // A bare token: number or boolean.
-    std::string token;
-    while (!eof() && (is_bare_key_char(peek()) || peek() == '.' || peek() == '+')) {
-      token += peek();
-      advance();
-    }
-    if (token.empty()) throw MatrixError(v.where, std::string("unexpected '") + c + "': expected a value");
-    if (token == "true" || token == "false") {
+      v.text = s->get();
+    } else if (n.is_integer() || n.is_floating_point()) {
+      v.kind = MatrixValue::Kind::kNumber;
+      v.text = src_.slice(n.source());
+      v.number = n.is_integer() ? double(n.as_integer()->get()) : n.as_floating_point()->get();
+      if (!std::isfinite(v.number)) throw MatrixError(v.where, "'" + v.text + "' is not a finite number");
+    } else if (const auto* b = n.as_boolean()) {
       v.kind = MatrixValue::Kind::kBool;
-      v.boolean = token == "true";
-      return v;
+      v.boolean = b->get();
+    } else if (const auto* a = n.as_array()) {
+      if (in_array) throw MatrixError(v.where, key + ": nested arrays are not supported");
+      v.kind = MatrixValue::Kind::kArray;
+      for (const toml::node& item : *a) v.items.push_back(value(item, key, true));
+    } else if (n.is_table()) {
+      throw MatrixError(v.where, key + ": a table is not a value here (arrays hold numbers, strings or true/false)");
+    } else {
+      throw MatrixError(v.where, key + ": dates and times are not values of a matrix file (strings are quoted)");
     }
-    std::string digits;  // TOML allows '_' between digits
-    for (char d : token)
-      if (d != '_') digits += d;
-    char* end = nullptr;
-    errno = 0;
-    const double x = std::strtod(digits.c_str(), &end);
-    const bool numeric_start = std::isdigit(static_cast<unsigned char>(digits[0])) || digits[0] == '+' ||
-                               digits[0] == '-' || digits[0] == '.';
-    if (end == digits.c_str() + digits.size() && !std::isfinite(x))
-      throw MatrixError(v.where, "'" + token + "' is not a finite number");
-    if (!numeric_start || end != digits.c_str() + digits.size())
-      throw MatrixError(v.where, "'" + token + "' is not a number, true/false, array or string (strings are "
-                                 "quoted: \"" + token + "\")");
-    if (!std::isfinite(x) || errno == ERANGE) throw MatrixError(v.where, "'" + token + "' is not a finite number");
-    v.kind = MatrixValue::Kind::kNumber;
-    v.number = x;
-    v.text = token;
     return v;
   }
 
-  std::string parse_string() {
-    const SourceLocation start = here();
-    const char quote = peek();
-    advance();
-    std::string out;
-    while (true) {
-      if (eof() || peek() == '\n') throw MatrixError(start, "unterminated string");
-      const char c = peek();
-      if (c == quote) {
-        advance();
-        return out;
+  const SourceText& src_;
+};
+
+// Refuses, before toml++ 3.3.0 sees the text, what it mishandles:
+// - it reaches __builtin_unreachable (undefined behaviour) when it asks
+//   whether some non-ASCII characters are whitespace: outside strings and
+//   comments, and first after a line-ending backslash in a """ string
+//   (marzer/tomlplusplus issues 190 and 295). TOML allows non-ASCII only in
+//   strings and comments: this refuses what toml++ would refuse anyway, plus
+//   that one valid case;
+// - it recurses once per part of a dotted key (a stack overflow at some
+//   100 000 parts); a matrix key has at most three.
+void refuse_what_toml_mishandles(const std::string& s, const std::string& file) {
+  constexpr int kMaxDots = 64;  // in a row, outside strings and comments
+  enum class In { kCode, kComment, kBasic, kLiteral, kMultiBasic, kMultiLiteral } in = In::kCode;
+  int line = 1, column = 1, dots = 0;
+  char prev = '\n';  // the character before, in code
+  size_t i = s.rfind("\xEF\xBB\xBF", 0) == 0 ? 3 : 0;
+  auto starts = [&](const char* t) { return s.compare(i, std::strlen(t), t) == 0; };
+  auto advance = [&](size_t n) {
+    for (; n > 0 && i < s.size(); --n, ++i) {
+      if (s[i] == '\n') {
+        ++line;
+        column = 1;
+      } else if (!is_utf8_continuation(s[i])) {
+        ++column;
       }
-      if (c == '\\' && quote == '"') {
-        const SourceLocation esc = here();
-        advance();
-        switch (eof() ? '\0' : peek()) {
-          case '"': out += '"'; break;
-          case '\\': out += '\\'; break;
-          case 'n': out += '\n'; break;
-          case 't': out += '\t'; break;
-          default: throw MatrixError(esc, "unknown escape in string (known: \\\" \\\\ \\n \\t)");
-        }
-        advance();
+    }
+  };
+  const auto refuse = [&](const std::string& what) { throw MatrixError({file, line, column}, what); };
+  while (i < s.size()) {
+    const char c = s[i];
+    if (in == In::kCode) {
+      if (static_cast<unsigned char>(c) >= 0x80)
+        refuse("non-ASCII character outside a string or comment (TOML allows them only there)");
+      if (c == '.' && ++dots > kMaxDots)
+        refuse("more than " + std::to_string(kMaxDots) + " dots in a dotted key (a matrix key has at most three "
+               "parts: param.METHOD.NAME)");
+      if (!is_bare_key_char(c) && std::string_view(". \t\"'").find(c) == std::string_view::npos) dots = 0;
+      // A quote starts a string where a value or a key may start; within a
+      // bare word (`0xZ"..`) toml++ reads on to the next blank, ',' or ']'.
+      const bool token_start = std::string_view("\n\r \t=[{,").find(prev) != std::string_view::npos;
+      if (c == '#') in = In::kComment;
+      if (c == '"' && token_start) in = starts("\"\"\"") ? (advance(2), In::kMultiBasic) : In::kBasic;
+      if (c == '\'' && token_start) in = starts("\'\'\'") ? (advance(2), In::kMultiLiteral) : In::kLiteral;
+      prev = c;
+    } else if (c == '\n' && in != In::kMultiBasic && in != In::kMultiLiteral) {
+      in = In::kCode;  // end of a comment (or of an unterminated string: toml++ says so)
+      prev = c;
+    } else if ((in == In::kBasic && c == '"') || (in == In::kLiteral && c == '\'')) {
+      in = In::kCode;
+      prev = c;
+    } else if ((in == In::kMultiBasic && starts("\"\"\"")) || (in == In::kMultiLiteral && starts("\'\'\'"))) {
+      advance(2);
+      while (i + 1 < s.size() && s[i + 1] == c) advance(1);  // up to two quotes belong to the string
+      in = In::kCode;
+      prev = c;
+    } else if ((in == In::kBasic || in == In::kMultiBasic) && c == '\\') {
+      size_t j = i + 1;  // a line-ending backslash: blanks, newline, then whitespace is skipped
+      while (in == In::kMultiBasic && j < s.size() && (s[j] == ' ' || s[j] == '\t' || s[j] == '\r')) ++j;
+      if (in == In::kMultiBasic && j < s.size() && s[j] == '\n') {
+        while (j < s.size() && std::string_view(" \t\r\n").find(s[j]) != std::string_view::npos) ++j;
+        advance(j - i);
+        if (i < s.size() && static_cast<unsigned char>(s[i]) >= 0x80)
+          refuse("non-ASCII character first after a line-ending backslash: toml++ 3.3 cannot read it "
+                 "(put an ASCII character before it)");
         continue;
       }
-      out += c;
-      advance();
+      advance(1);  // the escaped character is skipped below
     }
+    advance(1);
   }
+}
 
-  const std::string& s_;
-  std::string file_;
-  size_t pos_ = 0;
-  int line_ = 1, col_ = 1;
-};
+// toml++'s description of a syntax error, with a hint where it is terse.
+std::string syntax_error_message(const toml::parse_error& e, const SourceText& src) {
+  std::string what(e.description());
+  const auto has = [&](const char* part) { return what.find(part) != std::string::npos; };
+  const char at = src.char_at(e.source().begin);
+  const std::string word = src.word_at(e.source().begin);
+  if (has("could not determine value type") && !word.empty())  // a bare word
+    return "'" + word + "' is not a number, true/false, array or string (strings are quoted: \"" + word + "\")";
+  if (has("parsing string") && (at == '\n' || at == '\r' || at == '\0'))
+    what += " (unterminated string: missing its closing quote on this line)";
+  else if (has("parsing array") && has("end-of-file"))
+    what += " (unterminated array: missing ']')";
+  return what;
+}
 
 }  // namespace
 
 MatrixFile parse_matrix(const std::string& text, const std::string& file_name) {
-  return Parser(text, file_name).parse();
+  MatrixFile out;
+  out.name = file_name;
+  out.text = text;
+  const SourceText src(out.text, file_name);
+  refuse_what_toml_mishandles(out.text, file_name);
+  toml::table root;
+  try {
+    root = toml::parse(std::string_view(out.text), std::string_view(file_name));
+  } catch (const toml::parse_error& e) {
+    throw MatrixError(src.at(e.source().begin), syntax_error_message(e, src));
+  }
+  out.sections = TreeReader(src).sections(root);
+  return out;
 }
 
 MatrixFile read_matrix_file(const std::string& path) {
@@ -473,7 +548,10 @@ std::string canonical_text(const RunConfig& c, int repeats, double timeout, doub
   std::string params;
   for (const auto& [k, v] : c.params) params += (params.empty() ? "" : ";") + k + "=" + v;
   std::string times;
-  for (double t : c.times) times += (times.empty() ? "" : ",") + format_exact(t);
+  for (double t : c.times) {
+    if (!times.empty()) times += ',';
+    times += format_exact(t);
+  }
   std::ostringstream s;
   s << "problem=" << c.problem << "\nmethod=" << c.method << "\nformulation=" << c.formulation
     << "\nintegrator=" << c.integrator << "\nstep=" << format_exact(c.step.step)
@@ -502,199 +580,262 @@ std::string CaseEntry::label() const {
 // Limits on one matrix (the default one has under 1000 cases).
 constexpr size_t kMaxCases = 100000;
 
-Expansion expand_matrix(const MatrixFile& file, const MatrixCatalog& catalog) {
-  Expansion out;
-  const MatrixSection* defaults = nullptr;
-  for (const auto& sec : file.sections) {
-    check_keys(sec);
-    if (sec.kind == "defaults") defaults = &sec;
-  }
-  std::set<std::string> seen_ids, seen_names;
-  size_t duplicates = 0;
-  double planned = 0;  // upper bound of the cases so far
-  int sweep_number = 0;
-  for (const auto& sec : file.sections) {
-    if (sec.kind != "sweep") continue;
-    ++sweep_number;
-    const Settings set(defaults, sec);
-    const bool optional = set.boolean("optional", false);
+namespace {
 
-    std::string name = "sweep" + std::to_string(sweep_number);
+// One [[sweep]] with every choice of its product read and checked; the
+// counters are filled while the product is built.
+struct SweepPlan {
+  const MatrixSection* sec = nullptr;
+  std::string name;
+  bool optional = false;
+  bool every_problem = false, every_method = false;
+  std::vector<const Problem*> problems;
+  std::vector<const MethodInfo*> methods;
+  std::vector<const IntegratorInfo*> integrators;
+  std::vector<const MatrixValue*> steps, tols, rtols, atols;
+  std::vector<TEnd> t_ends;
+  std::vector<const MatrixValue*> formulations, times;
+  const MatrixValue* ref_time_value = nullptr;  // for messages
+  double ref_time = -1, sample_every = 0, blowup = 1e3, timeout = 0, repeat_if_under = 0;
+  int observe_every = 1, repeats = 1;
+  bool series = true, work_precision = true, overlay = false;
+  std::vector<double> perturbs;
+  std::vector<ParamChoice> params;
+  size_t not_applicable = 0, wrong_integrator = 0;
+};
+
+// Builds the cases of every sweep, in order, keeping identical ones once.
+class Expander {
+ public:
+  explicit Expander(const MatrixCatalog& catalog) : catalog_(catalog) {}
+
+  // Stage 0: the whole file (key checks first, then each sweep).
+  Expansion run(const MatrixFile& file) {
+    const MatrixSection* defaults = nullptr;
+    for (const auto& sec : file.sections) {
+      check_keys(sec);
+      if (sec.kind == "defaults") defaults = &sec;
+    }
+    int sweep_number = 0;
+    for (const auto& sec : file.sections)
+      if (sec.kind == "sweep") expand_sweep(Settings(defaults, sec), sec, ++sweep_number);
+    if (duplicates_)
+      out_.notes.push_back(std::to_string(duplicates_) + " duplicate cases dropped (same configuration)");
+    if (sweep_number == 0) throw MatrixError({file.name, 1, 1}, "no [[sweep]] table: nothing to run");
+    return std::move(out_);
+  }
+
+ private:
+  // One sweep: read its choices, build its product, check it made cases.
+  void expand_sweep(const Settings& set, const MatrixSection& sec, int number) {
+    SweepPlan p;
+    p.sec = &sec;
+    read_name(set, number, p);
+    const size_t notes_before = out_.notes.size(), cases_before = out_.cases.size();
+    const size_t duplicates_before = duplicates_;
+    resolve_problems(set, p);
+    resolve_methods(set, p);
+    resolve_integrators(set, p);
+    read_step_settings(set, p);
+    read_t_ends(set, p);
+    read_run_settings(set, p);
+    read_param_choices(set, p);
+    check_formulations(p);
+    for (const Problem* problem : p.problems)
+      for (const MethodInfo* method : p.methods) expand_pair(p, *problem, *method);
+    finish_sweep(p, notes_before, cases_before, duplicates_before);
+  }
+
+  void note(const SweepPlan& p, const std::string& text) { out_.notes.push_back("sweep '" + p.name + "': " + text); }
+
+  // Stage 1: `optional` and the sweep's name (unique, usable in a CSV cell).
+  void read_name(const Settings& set, int number, SweepPlan& p) {
+    p.optional = set.boolean("optional", false);
+    p.name = "sweep" + std::to_string(number);
     if (const MatrixValue* v = set.scalar("name", Kind::kString)) {
       if (v->text.empty() || v->text.find_first_of(",\"\n") != std::string::npos)
         throw MatrixError(v->where, "name: must be non-empty, without commas or quotes");
-      name = v->text;
-      if (!seen_names.insert(name).second) throw MatrixError(v->where, "name: '" + name + "' used by another sweep");
+      p.name = v->text;
+      if (!seen_names_.insert(p.name).second)
+        throw MatrixError(v->where, "name: '" + p.name + "' used by another sweep");
     }
-    auto note = [&](const std::string& text) { out.notes.push_back("sweep '" + name + "': " + text); };
-    const size_t notes_before = out.notes.size();
+  }
 
-    // ---- problems ----
-    bool every_problem = false;
-    std::vector<const Problem*> problems;
-    const auto problem_names = set.names("problems", &every_problem);
-    if (every_problem) {
-      problems = catalog.problems;
-    } else {
-      if (problem_names.empty()) throw MatrixError(sec.where, "sweep '" + name + "' has no 'problems'");
-      for (const auto* v : problem_names) {
-        auto it = std::find_if(catalog.problems.begin(), catalog.problems.end(),
-                               [&](const Problem* p) { return p->info().name == v->text; });
-        if (it != catalog.problems.end()) {
-          problems.push_back(*it);
-          continue;
-        }
+  // Stage 2: `problems`, "all" or names of the catalog.
+  void resolve_problems(const Settings& set, SweepPlan& p) {
+    const auto names = set.names("problems", &p.every_problem);
+    if (p.every_problem) {
+      p.problems = catalog_.problems;
+      return;
+    }
+    if (names.empty()) throw MatrixError(p.sec->where, "sweep '" + p.name + "' has no 'problems'");
+    for (const auto* v : names) {
+      auto it = std::find_if(catalog_.problems.begin(), catalog_.problems.end(),
+                             [&](const Problem* pr) { return pr->info().name == v->text; });
+      if (it != catalog_.problems.end()) {
+        p.problems.push_back(*it);
+        continue;
+      }
+      std::vector<std::string> known;
+      for (const auto* pr : catalog_.problems) known.push_back(pr->info().name);
+      if (p.optional) {
+        note(p, "problem '" + v->text + "' is not in this build (optional sweep): skipped");
+        continue;
+      }
+      throw MatrixError(v->where, "unknown problem '" + v->text + "'" + suggestion(v->text, known) +
+                                      " (known: " + join(known, ", ") + "; or \"all\")");
+    }
+  }
+
+  // Stage 3: `methods`, "all" or names of the catalog.
+  void resolve_methods(const Settings& set, SweepPlan& p) {
+    const auto names = set.names("methods", &p.every_method);
+    if (p.every_method) {
+      for (const auto& m : catalog_.methods) p.methods.push_back(&m);
+      return;
+    }
+    if (names.empty()) throw MatrixError(p.sec->where, "sweep '" + p.name + "' has no 'methods'");
+    for (const auto* v : names) {
+      auto it = std::find_if(catalog_.methods.begin(), catalog_.methods.end(),
+                             [&](const MethodInfo& m) { return m.name == v->text; });
+      if (it != catalog_.methods.end()) {
+        p.methods.push_back(&*it);
+        continue;
+      }
+      std::vector<std::string> known;
+      for (const auto& m : catalog_.methods) known.push_back(m.name);
+      if (p.optional) {
+        note(p, "method '" + v->text + "' is not in this build (optional sweep): skipped");
+        continue;
+      }
+      throw MatrixError(v->where, "unknown method '" + v->text + "'" + suggestion(v->text, known) +
+                                      " (known: " + join(known, ", ") + "; or \"all\")");
+    }
+  }
+
+  // Stage 4: `integrators`, "all" or names of this build.
+  void resolve_integrators(const Settings& set, SweepPlan& p) {
+    bool every = false;
+    const auto names = set.names("integrators", &every);
+    if (every) {
+      for (const auto& i : all_integrators()) p.integrators.push_back(&i);
+      return;
+    }
+    if (names.empty()) throw MatrixError(p.sec->where, "sweep '" + p.name + "' has no 'integrators'");
+    for (const auto* v : names) {
+      auto it = std::find_if(all_integrators().begin(), all_integrators().end(),
+                             [&](const IntegratorInfo& i) { return i.name == v->text; });
+      if (it == all_integrators().end() && p.optional) {
+        note(p, "integrator '" + v->text + "' is not in this build (optional sweep): skipped");
+        continue;
+      }
+      if (it == all_integrators().end()) {
         std::vector<std::string> known;
-        for (const auto* p : catalog.problems) known.push_back(p->info().name);
-        if (optional) {
-          note("problem '" + v->text + "' is not in this build (optional sweep): skipped");
-          continue;
-        }
-        throw MatrixError(v->where, "unknown problem '" + v->text + "'" + suggestion(v->text, known) +
-                                        " (known: " + join(known, ", ") + "; or \"all\")");
+        for (const auto& i : all_integrators()) known.push_back(i.name);
+        throw MatrixError(v->where, "unknown integrator '" + v->text + "'" + suggestion(v->text, known) +
+                                        " (known: " + join(known, ", ") + ")");
       }
+      p.integrators.push_back(&*it);
     }
+  }
 
-    // ---- methods ----
-    bool every_method = false;
-    std::vector<const MethodInfo*> methods;
-    const auto method_names = set.names("methods", &every_method);
-    if (every_method) {
-      for (const auto& m : catalog.methods) methods.push_back(&m);
-    } else {
-      if (method_names.empty()) throw MatrixError(sec.where, "sweep '" + name + "' has no 'methods'");
-      for (const auto* v : method_names) {
-        auto it = std::find_if(catalog.methods.begin(), catalog.methods.end(),
-                               [&](const MethodInfo& m) { return m.name == v->text; });
-        if (it != catalog.methods.end()) {
-          methods.push_back(&*it);
-          continue;
-        }
-        std::vector<std::string> known;
-        for (const auto& m : catalog.methods) known.push_back(m.name);
-        if (optional) {
-          note("method '" + v->text + "' is not in this build (optional sweep): skipped");
-          continue;
-        }
-        throw MatrixError(v->where, "unknown method '" + v->text + "'" + suggestion(v->text, known) +
-                                        " (known: " + join(known, ", ") + "; or \"all\")");
-      }
-    }
-
-    // ---- integrators and their step settings ----
-    bool every_integrator = false;
-    std::vector<const IntegratorInfo*> integrators;
-    const auto integrator_names = set.names("integrators", &every_integrator);
-    if (every_integrator) {
-      for (const auto& i : all_integrators()) integrators.push_back(&i);
-    } else {
-      if (integrator_names.empty()) throw MatrixError(sec.where, "sweep '" + name + "' has no 'integrators'");
-      for (const auto* v : integrator_names) {
-        auto it = std::find_if(all_integrators().begin(), all_integrators().end(),
-                               [&](const IntegratorInfo& i) { return i.name == v->text; });
-        if (it == all_integrators().end() && optional) {
-          note("integrator '" + v->text + "' is not in this build (optional sweep): skipped");
-          continue;
-        }
-        if (it == all_integrators().end()) {
-          std::vector<std::string> known;
-          for (const auto& i : all_integrators()) known.push_back(i.name);
-          throw MatrixError(v->where, "unknown integrator '" + v->text + "'" + suggestion(v->text, known) +
-                                          " (known: " + join(known, ", ") + ")");
-        }
-        integrators.push_back(&*it);
-      }
-    }
-    const auto steps = set.list("step", Kind::kNumber);
-    const auto tols = set.list("tol", Kind::kNumber);
-    const auto rtols = set.list("rtol", Kind::kNumber);
-    const auto atols = set.list("atol", Kind::kNumber);
-    for (const auto* list : {&steps, &tols, &rtols, &atols})
+  // Stage 5: `step` / `tol` / `rtol` + `atol`, each what its integrators need.
+  static void read_step_settings(const Settings& set, SweepPlan& p) {
+    p.steps = set.list("step", Kind::kNumber);
+    p.tols = set.list("tol", Kind::kNumber);
+    p.rtols = set.list("rtol", Kind::kNumber);
+    p.atols = set.list("atol", Kind::kNumber);
+    for (const auto* list : {&p.steps, &p.tols, &p.rtols, &p.atols})
       for (const auto* v : *list)
         if (!(v->number > 0)) throw MatrixError(v->where, "step sizes and tolerances must be > 0");
-    if (!tols.empty() && (!rtols.empty() || !atols.empty()))
+    if (!p.tols.empty() && (!p.rtols.empty() || !p.atols.empty()))
       throw MatrixError(set.find("tol")->where, "give either 'tol' (rtol = atol) or 'rtol' and 'atol', not both");
-    if (tols.empty() && (rtols.empty() != atols.empty()))
-      throw MatrixError((rtols.empty() ? set.find("atol") : set.find("rtol"))->where,
+    if (p.tols.empty() && (p.rtols.empty() != p.atols.empty()))
+      throw MatrixError((p.rtols.empty() ? set.find("atol") : set.find("rtol"))->where,
                         "'rtol' and 'atol' go together (or use 'tol' for both)");
-    const bool have_tol = !tols.empty() || !rtols.empty();
+    const bool have_tol = !p.tols.empty() || !p.rtols.empty();
     bool any_fixed = false, any_adaptive = false;
-    for (const auto* i : integrators) {
+    for (const auto* i : p.integrators) {
       (i->fixed_step ? any_fixed : any_adaptive) = true;
       const MatrixEntry* ie = set.find("integrators");
-      const SourceLocation& at = ie ? ie->where : sec.where;
-      if (i->fixed_step && steps.empty())
+      const SourceLocation& at = ie ? ie->where : p.sec->where;
+      if (i->fixed_step && p.steps.empty())
         throw MatrixError(at, "integrator '" + i->name + "' is fixed-step: the sweep needs 'step'");
       if (!i->fixed_step && !have_tol)
         throw MatrixError(at, "integrator '" + i->name + "' is adaptive: the sweep needs 'tol' (or 'rtol' and 'atol')");
     }
-    if (!steps.empty() && !any_fixed && !integrators.empty())
+    if (!p.steps.empty() && !any_fixed && !p.integrators.empty())
       throw MatrixError(set.find("step")->where, "'step' given but no integrator of the sweep is fixed-step");
-    if (have_tol && !any_adaptive && !integrators.empty())
-      throw MatrixError((tols.empty() ? set.find("rtol") : set.find("tol"))->where,
+    if (have_tol && !any_adaptive && !p.integrators.empty())
+      throw MatrixError((p.tols.empty() ? set.find("rtol") : set.find("tol"))->where,
                         "tolerances given but no integrator of the sweep is adaptive");
+  }
 
-    // ---- horizon, observation, repeats ----
-    std::vector<TEnd> t_ends;
-    if (const MatrixEntry* e = set.find("t_end")) {
-      std::vector<const MatrixValue*> vals;
-      if (e->value.kind == Kind::kArray)
-        for (const auto& item : e->value.items) vals.push_back(&item);
-      else
-        vals.push_back(&e->value);
-      for (const auto* v : vals) {
-        if (v->kind == Kind::kString && (v->text == "ref" || v->text == "default")) {
-          t_ends.push_back({v->text, 0, v->where});
-        } else if (v->kind == Kind::kNumber && v->number > 0) {
-          t_ends.push_back({"", v->number, v->where});
-        } else {
-          throw MatrixError(v->where, "t_end: expected a number > 0, \"ref\" (the problem's reference time) or "
-                                      "\"default\" (the problem's default horizon)");
-        }
-      }
-    } else {
-      t_ends.push_back({"default", 0, sec.where});
+  // Stage 6: `t_end`, numbers, "ref" or "default" (one value or an array).
+  static void read_t_ends(const Settings& set, SweepPlan& p) {
+    const MatrixEntry* e = set.find("t_end");
+    if (!e) {
+      p.t_ends.push_back({"default", 0, p.sec->where});
+      return;
     }
-    std::vector<const MatrixValue*> formulations = set.list("formulations", Kind::kString);
-    const auto times = set.list("times", Kind::kNumber);
-    const double ref_time = set.number("ref_time", -1);
-    const double sample_every = set.number("sample_every", 0);
-    const double blowup = set.number("blowup", 1e3);
+    std::vector<const MatrixValue*> vals;
+    if (e->value.kind == Kind::kArray)
+      for (const auto& item : e->value.items) vals.push_back(&item);
+    else
+      vals.push_back(&e->value);
+    for (const auto* v : vals) {
+      if (v->kind == Kind::kString && (v->text == "ref" || v->text == "default")) {
+        p.t_ends.push_back({v->text, 0, v->where});
+      } else if (v->kind == Kind::kNumber && v->number > 0) {
+        p.t_ends.push_back({"", v->number, v->where});
+      } else {
+        throw MatrixError(v->where, "t_end: expected a number > 0, \"ref\" (the problem's reference time) or "
+                                    "\"default\" (the problem's default horizon)");
+      }
+    }
+  }
+
+  // Stage 7: observation, repeats, timeout, flags and `perturb`.
+  static void read_run_settings(const Settings& set, SweepPlan& p) {
+    p.formulations = set.list("formulations", Kind::kString);
+    p.times = set.list("times", Kind::kNumber);
+    p.ref_time = set.number("ref_time", -1);
+    if (const MatrixEntry* e = set.find("ref_time")) p.ref_time_value = &e->value;
+    p.sample_every = set.number("sample_every", 0);
+    p.blowup = set.number("blowup", 1e3);
     const double observe_every = set.number("observe_every", 1);
-    const double repeats_num = set.number("repeats", 1);
-    const double timeout = set.number("timeout", 0);
-    const double repeat_if_under = set.number("repeat_if_under", 0);
+    const double repeats = set.number("repeats", 1);
+    p.timeout = set.number("timeout", 0);
+    p.repeat_if_under = set.number("repeat_if_under", 0);
     auto check = [&](const char* key, bool ok, const std::string& what) {
-      if (!ok) throw MatrixError(set.find(key)->value.where, std::string(key) + ": " + what);
+      if (set.find(key) && !ok) throw MatrixError(set.find(key)->value.where, std::string(key) + ": " + what);
     };
-    if (set.find("ref_time")) check("ref_time", ref_time >= 0, "must be >= 0 (0: no reference error)");
-    if (set.find("sample_every")) check("sample_every", sample_every >= 0, "must be >= 0 (0: t_end / 1000)");
-    if (set.find("blowup")) check("blowup", blowup > 0, "must be > 0");
-    if (set.find("observe_every"))
-      check("observe_every", observe_every >= 1 && observe_every <= 1e9 && observe_every == std::floor(observe_every),
-            "must be an integer in [1, 1e9]");
-    for (const auto* v : times)
+    check("ref_time", p.ref_time >= 0, "must be >= 0 (0: no reference error)");
+    check("sample_every", p.sample_every >= 0, "must be >= 0 (0: t_end / 1000)");
+    check("blowup", p.blowup > 0, "must be > 0");
+    check("observe_every", observe_every >= 1 && observe_every <= 1e9 && observe_every == std::floor(observe_every),
+          "must be an integer in [1, 1e9]");
+    for (const auto* v : p.times)
       if (!(v->number > 0)) throw MatrixError(v->where, "times: " + v->text + " must be > 0");
-    if (set.find("repeats"))
-      check("repeats", repeats_num >= 1 && repeats_num <= 1000 && repeats_num == std::floor(repeats_num),
-            "must be an integer in [1, 1000]");
-    if (set.find("timeout")) check("timeout", timeout >= 0, "must be >= 0 seconds (0: none)");
-    if (set.find("repeat_if_under"))
-      check("repeat_if_under", repeat_if_under >= 0, "must be >= 0 seconds (0: always repeat)");
-    const int repeats = int(repeats_num);
-    const bool series = set.boolean("series", true);
-    std::vector<double> perturbs;
+    check("repeats", repeats >= 1 && repeats <= 1000 && repeats == std::floor(repeats),
+          "must be an integer in [1, 1000]");
+    check("timeout", p.timeout >= 0, "must be >= 0 seconds (0: none)");
+    check("repeat_if_under", p.repeat_if_under >= 0, "must be >= 0 seconds (0: always repeat)");
+    p.observe_every = int(observe_every);
+    p.repeats = int(repeats);
+    p.series = set.boolean("series", true);
     for (const auto* v : set.list("perturb", Kind::kNumber)) {
       if (!std::isfinite(v->number) || v->number < 0)
         throw MatrixError(v->where, "perturb: must be a number >= 0 (0: consistent start)");
-      perturbs.push_back(v->number);
+      p.perturbs.push_back(v->number);
     }
-    if (perturbs.empty()) perturbs.push_back(0);
-    const bool work_precision = set.boolean("work_precision", true);
-    const bool overlay = set.boolean("overlay", false);
+    if (p.perturbs.empty()) p.perturbs.push_back(0);
+    p.work_precision = set.boolean("work_precision", true);
+    p.overlay = set.boolean("overlay", false);
+  }
 
-    // ---- parameters ----
-    std::vector<ParamChoice> param_choices;
+  // Stage 8: the `param.NAME` and `param.METHOD.NAME` keys, in file order.
+  void read_param_choices(const Settings& set, SweepPlan& p) const {
     for (const MatrixEntry* e : set.params()) {
       ParamChoice pc;
       const std::string rest = e->key.substr(6);
@@ -704,8 +845,8 @@ Expansion expand_matrix(const MatrixFile& file, const MatrixCatalog& catalog) {
       } else {
         pc.method = rest.substr(0, dot);
         pc.name = rest.substr(dot + 1);
-        if (std::none_of(catalog.methods.begin(), catalog.methods.end(),
-                         [&](const MethodInfo& m) { return m.name == pc.method; }) && !optional)
+        if (std::none_of(catalog_.methods.begin(), catalog_.methods.end(),
+                         [&](const MethodInfo& m) { return m.name == pc.method; }) && !p.optional)
           throw MatrixError(e->where, "'" + e->key + "': unknown method '" + pc.method + "'");
       }
       pc.where = e->where;
@@ -717,217 +858,242 @@ Expansion expand_matrix(const MatrixFile& file, const MatrixCatalog& catalog) {
       }
       for (const auto* v : pc.values)
         if (v->kind != Kind::kNumber) throw MatrixError(v->where, e->key + ": expected a number");
-      param_choices.push_back(std::move(pc));
+      p.params.push_back(std::move(pc));
     }
+  }
 
-    for (const auto* f : formulations) {
-      const bool known = std::any_of(problems.begin(), problems.end(), [&](const Problem* p) {
-        const auto& fs = p->info().formulations;
+  // Stage 9: every formulation named belongs to one of the sweep's problems.
+  static void check_formulations(const SweepPlan& p) {
+    for (const auto* f : p.formulations) {
+      const bool known = std::any_of(p.problems.begin(), p.problems.end(), [&](const Problem* pr) {
+        const auto& fs = pr->info().formulations;
         return std::any_of(fs.begin(), fs.end(), [&](const FormulationInfo& fi) { return fi.name == f->text; });
       });
-      if (!known && !problems.empty()) {
-        std::vector<std::string> names;
-        for (const Problem* p : problems)
-          for (const auto& fi : p->info().formulations)
-            if (std::find(names.begin(), names.end(), fi.name) == names.end()) names.push_back(fi.name);
-        throw MatrixError(f->where, "unknown formulation '" + f->text + "'" + suggestion(f->text, names) +
-                                        " for the sweep's problems (known: " + join(names, ", ") + ")");
-      }
+      if (known || p.problems.empty()) continue;
+      std::vector<std::string> names;
+      for (const Problem* pr : p.problems)
+        for (const auto& fi : pr->info().formulations)
+          if (std::find(names.begin(), names.end(), fi.name) == names.end()) names.push_back(fi.name);
+      throw MatrixError(f->where, "unknown formulation '" + f->text + "'" + suggestion(f->text, names) +
+                                      " for the sweep's problems (known: " + join(names, ", ") + ")");
     }
-
-    // ---- the product ----
-    size_t not_applicable = 0, wrong_integrator = 0;
-    const size_t cases_before = out.cases.size(), duplicates_before = duplicates;
-    for (const Problem* problem : problems) {
-      const ProblemInfo& info = problem->info();
-      for (const MethodInfo* method : methods) {
-        const std::string why = problem->why_not(method->name);
-        if (!why.empty()) {
-          if (!every_method && !every_problem)
-            note(method->name + " does not apply to " + info.name + ": " + why);
-          ++not_applicable;
-          continue;
-        }
-        // Parameters this method declares on this problem, and which of the
-        // sweep's param.* keys apply to it.
-        std::vector<ParamSpec> specs;
-        try {
-          specs = problem->method_params(method->name, "");
-        } catch (const UsageError& e) {
-          note(method->name + " on " + info.name + ": " + e.what());
-          continue;
-        }
-        // A DAE formulation F(t, y, y') = 0 needs a DAE integrator and an
-        // ODE one an ODE integrator: impossible pairs are not cases.
-        int is_dae = -1;  // -1: unknown (the formulation cannot be built with defaults)
-        try {
-          const auto f = problem->make(method->name, "", Params::resolve(specs, {}, method->name));
-          if (f) is_dae = dynamic_cast<const DaeSystem*>(f.get()) != nullptr;
-        } catch (const UsageError&) {
-        }
-        std::vector<ParamChoice*> applying;
-        for (auto& pc : param_choices) {
-          if (!pc.method.empty() && pc.method != method->name) continue;
-          if (std::none_of(specs.begin(), specs.end(), [&](const ParamSpec& s) { return s.name == pc.name; })) {
-            if (!pc.method.empty()) {
-              std::vector<std::string> known;
-              for (const auto& s : specs) known.push_back(s.name);
-              throw MatrixError(pc.where, "method '" + method->name + "' has no parameter '" + pc.name +
-                                              "' on problem '" + info.name + "' (known: " + join(known, ", ") + ")");
-            }
-            continue;
-          }
-          const ParamSpec& spec =
-              *std::find_if(specs.begin(), specs.end(), [&](const ParamSpec& s) { return s.name == pc.name; });
-          for (const auto* v : pc.values) {
-            if (spec.bound == Bound::kPositive && !(v->number > 0))
-              throw MatrixError(v->where, "param." + pc.name + " = " + v->text + ": must be > 0 for method '" +
-                                              method->name + "'");
-            if (spec.bound == Bound::kNonNegative && !(v->number >= 0))
-              throw MatrixError(v->where, "param." + pc.name + " = " + v->text + ": must be >= 0 for method '" +
-                                              method->name + "'");
-          }
-          pc.used = true;
-          applying.push_back(&pc);
-        }
-        std::vector<std::string> forms;
-        for (const auto* f : formulations) forms.push_back(f->text);
-        if (forms.empty()) forms.push_back("");
-        // An upper bound of what this pair adds, checked before anything is
-        // built: a typo like four arrays of 100 values must not eat the machine.
-        double planned_here = double(forms.size()) * double(integrators.size()) * double(t_ends.size()) *
-                              double(std::max({steps.size(), tols.size(), rtols.size() * atols.size(), size_t(1)}));
-        planned_here *= double(perturbs.size());
-        for (const ParamChoice* pc : applying) planned_here *= double(pc->values.size());
-        planned += planned_here;
-        if (planned > double(kMaxCases))
-          throw MatrixError(sec.where, "the matrix expands to more than " + std::to_string(kMaxCases) +
-                                           " cases: split it into several files");
-        for (const std::string& form : forms) {
-          if (!form.empty()) {
-            try {
-              problem->method_params(method->name, form);
-            } catch (const UsageError&) {
-              note(method->name + " on " + info.name + " has no formulation '" + form + "': skipped");
-              continue;
-            }
-          }
-          for (const IntegratorInfo* integ : integrators) {
-            if (is_dae >= 0 && bool(is_dae) != integ->solves_dae) {
-              ++wrong_integrator;
-              continue;
-            }
-            for (const TEnd& te : t_ends) {
-              double t_end = te.value;
-              if (te.mode == "ref") t_end = info.reference_time > 0 ? info.reference_time : info.default_t_end;
-              if (te.mode == "default") t_end = info.default_t_end;
-              if (ref_time > t_end)
-                throw MatrixError(set.find("ref_time")->value.where,
-                                  "ref_time: " + set.find("ref_time")->value.text + " is beyond t_end " +
-                                      format_short(t_end) + " (problem '" + info.name + "')");
-              for (const auto* v : times)
-                if (v->number > t_end)
-                  throw MatrixError(v->where, "times: " + v->text + " is beyond t_end " + format_short(t_end) +
-                                                  " (problem '" + info.name + "')");
-              // step settings
-              std::vector<StepSettings> settings;
-              if (integ->fixed_step) {
-                for (const auto* v : steps) {
-                  if (v->number > t_end) {
-                    note(info.name + ": step " + v->text + " larger than t_end " + format_short(t_end) + ": skipped");
-                    continue;
-                  }
-                  settings.push_back({v->number, 0, 0});
-                }
-              } else if (!tols.empty()) {
-                for (const auto* v : tols) settings.push_back({0, v->number, v->number});
-              } else {
-                for (const auto* r : rtols)
-                  for (const auto* a : atols) settings.push_back({0, r->number, a->number});
-              }
-              // parameter combinations (odometer over the applying choices)
-              std::vector<size_t> pick(applying.size(), 0);
-              while (true) {
-                for (const StepSettings& st : settings) for (const double perturb : perturbs) {
-                  MatrixCase c;
-                  RunConfig& cfg = c.config;
-                  cfg.problem = info.name;
-                  cfg.method = method->name;
-                  cfg.formulation = form;
-                  cfg.integrator = integ->name;
-                  for (size_t i = 0; i < applying.size(); ++i)
-                    cfg.params.emplace_back(applying[i]->name,
-                                            format_short(applying[i]->values[pick[i]]->number));
-                  cfg.step = st;
-                  cfg.t_end = t_end;
-                  for (const auto* v : times) cfg.times.push_back(v->number);
-                  cfg.sample_every = sample_every;
-                  cfg.ref_time = ref_time;
-                  cfg.blowup = blowup;
-                  cfg.observe_every = int(observe_every);
-                  cfg.write_series = series;
-                  cfg.perturb = perturb;
-                  c.timeout = timeout;
-                  c.repeat_if_under = repeat_if_under;
-                  c.config_text = canonical_text(cfg, repeats, timeout, repeat_if_under);
-                  CaseEntry& e = c.entry;
-                  e.id = hash_hex(c.config_text);
-                  if (!seen_ids.insert(e.id).second) {
-                    ++duplicates;
-                    continue;
-                  }
-                  e.index = out.cases.size();
-                  e.sweep = name;
-                  e.problem = cfg.problem;
-                  e.method = cfg.method;
-                  e.formulation = form;
-                  e.integrator = cfg.integrator;
-                  for (const auto& [k, v] : cfg.params) e.params += (e.params.empty() ? "" : ";") + k + "=" + v;
-                  if (integ->fixed_step)
-                    e.setting = "step=" + format_short(st.step);
-                  else if (st.rtol == st.atol)
-                    e.setting = "tol=" + format_short(st.rtol);
-                  else
-                    e.setting = "rtol=" + format_short(st.rtol) + ";atol=" + format_short(st.atol);
-                  if (perturb > 0) e.setting += ";perturb=" + format_short(perturb);
-                  e.t_end = t_end;
-                  e.repeats = repeats;
-                  e.work_precision = work_precision;
-                  e.overlay = overlay;
-                  e.curve = e.method + (form.empty() ? "" : "[" + form + "]") + "/" + e.integrator +
-                            (e.params.empty() ? "" : " " + e.params);
-                  c.cost_estimate = estimate_cost(cfg, *integ, repeats);
-                  out.cases.push_back(std::move(c));
-                }
-                size_t i = 0;
-                while (i < pick.size() && ++pick[i] == applying[i]->values.size()) pick[i++] = 0;
-                if (i == pick.size()) break;
-              }
-            }
-          }
-        }
-      }
-    }
-    for (const auto& pc : param_choices)
-      if (!pc.used && !optional)
-        note("param." + (pc.method.empty() ? "" : pc.method + ".") + pc.name + " (line " +
-             std::to_string(pc.where.line) + ") applies to no method of the sweep");
-    if (wrong_integrator)
-      note(std::to_string(wrong_integrator) + " method x integrator combinations skipped: DAE methods (ida-*) need "
-           "integrator 'ida', and 'ida' needs a DAE method");
-    if (out.cases.size() == cases_before && duplicates == duplicates_before && !optional) {
-      std::string why;
-      for (size_t i = notes_before; i < out.notes.size(); ++i) why += "; " + out.notes[i];
-      throw MatrixError(sec.where, "sweep '" + name + "' expands to no case" +
-                                       (why.empty() ? std::string() : why));
-    }
-    if (not_applicable && (every_method || every_problem))
-      note(std::to_string(not_applicable) + " problem x method combinations do not apply (see `cstab list`)");
   }
-  if (duplicates) out.notes.push_back(std::to_string(duplicates) + " duplicate cases dropped (same configuration)");
-  if (sweep_number == 0) throw MatrixError({file.name, 1, 1}, "no [[sweep]] table: nothing to run");
-  return out;
-}
+
+  // Stage 10: one problem x method pair: a note if it does not apply, else its formulations x integrators.
+  void expand_pair(SweepPlan& p, const Problem& problem, const MethodInfo& method) {
+    const ProblemInfo& info = problem.info();
+    const std::string why = problem.why_not(method.name);
+    if (!why.empty()) {
+      if (!p.every_method && !p.every_problem) note(p, method.name + " does not apply to " + info.name + ": " + why);
+      ++p.not_applicable;
+      return;
+    }
+    // Parameters this method declares on this problem.
+    std::vector<ParamSpec> specs;
+    try {
+      specs = problem.method_params(method.name, "");
+    } catch (const UsageError& e) {
+      note(p, method.name + " on " + info.name + ": " + e.what());
+      return;
+    }
+    // A DAE formulation F(t, y, y') = 0 needs a DAE integrator and an
+    // ODE one an ODE integrator: impossible pairs are not cases.
+    int is_dae = -1;  // -1: unknown (the formulation cannot be built with defaults)
+    try {
+      const auto f = problem.make(method.name, "", Params::resolve(specs, {}, method.name));
+      if (f) is_dae = dynamic_cast<const DaeSystem*>(f.get()) != nullptr;
+    } catch (const UsageError&) {
+    }
+    const std::vector<ParamChoice*> applying = applying_params(p, info, method, specs);
+    std::vector<std::string> forms;
+    for (const auto* f : p.formulations) forms.push_back(f->text);
+    if (forms.empty()) forms.push_back("");
+    check_budget(p, forms.size(), applying);
+    for (const std::string& form : forms) {
+      if (!form.empty()) {
+        try {
+          problem.method_params(method.name, form);
+        } catch (const UsageError&) {
+          note(p, method.name + " on " + info.name + " has no formulation '" + form + "': skipped");
+          continue;
+        }
+      }
+      for (const IntegratorInfo* integ : p.integrators) {
+        if (is_dae >= 0 && bool(is_dae) != integ->solves_dae) {
+          ++p.wrong_integrator;
+          continue;
+        }
+        for (const TEnd& te : p.t_ends) expand_run(p, info, method, form, *integ, te, applying);
+      }
+    }
+  }
+
+  // Stage 10a: the sweep's param.* keys that apply to this method, their values within its bounds.
+  static std::vector<ParamChoice*> applying_params(SweepPlan& p, const ProblemInfo& info, const MethodInfo& method,
+                                                   const std::vector<ParamSpec>& specs) {
+    std::vector<ParamChoice*> applying;
+    for (auto& pc : p.params) {
+      if (!pc.method.empty() && pc.method != method.name) continue;
+      const auto spec = std::find_if(specs.begin(), specs.end(), [&](const ParamSpec& s) { return s.name == pc.name; });
+      if (spec == specs.end()) {
+        if (!pc.method.empty()) {
+          std::vector<std::string> known;
+          for (const auto& s : specs) known.push_back(s.name);
+          throw MatrixError(pc.where, "method '" + method.name + "' has no parameter '" + pc.name +
+                                          "' on problem '" + info.name + "' (known: " + join(known, ", ") + ")");
+        }
+        continue;
+      }
+      for (const auto* v : pc.values) {
+        if (spec->bound == Bound::kPositive && !(v->number > 0))
+          throw MatrixError(v->where, "param." + pc.name + " = " + v->text + ": must be > 0 for method '" +
+                                          method.name + "'");
+        if (spec->bound == Bound::kNonNegative && !(v->number >= 0))
+          throw MatrixError(v->where, "param." + pc.name + " = " + v->text + ": must be >= 0 for method '" +
+                                          method.name + "'");
+      }
+      pc.used = true;
+      applying.push_back(&pc);
+    }
+    return applying;
+  }
+
+  // Stage 10b: the case budget (a bound of what this pair adds), checked before any case is built.
+  void check_budget(const SweepPlan& p, size_t forms, const std::vector<ParamChoice*>& applying) {
+    double planned_here =
+        double(forms) * double(p.integrators.size()) * double(p.t_ends.size()) *
+        double(std::max({p.steps.size(), p.tols.size(), p.rtols.size() * p.atols.size(), size_t(1)}));
+    planned_here *= double(p.perturbs.size());
+    for (const ParamChoice* pc : applying) planned_here *= double(pc->values.size());
+    planned_ += planned_here;
+    if (planned_ > double(kMaxCases))
+      throw MatrixError(p.sec->where, "the matrix expands to more than " + std::to_string(kMaxCases) +
+                                          " cases: split it into several files");
+  }
+
+  // Stage 11: one t_end: output times checked, then parameter combinations x step settings x perturb.
+  void expand_run(const SweepPlan& p, const ProblemInfo& info, const MethodInfo& method, const std::string& form,
+                  const IntegratorInfo& integ, const TEnd& te, const std::vector<ParamChoice*>& applying) {
+    double t_end = te.value;
+    if (te.mode == "ref") t_end = info.reference_time > 0 ? info.reference_time : info.default_t_end;
+    if (te.mode == "default") t_end = info.default_t_end;
+    if (p.ref_time > t_end)
+      throw MatrixError(p.ref_time_value->where, "ref_time: " + p.ref_time_value->text + " is beyond t_end " +
+                                                     format_short(t_end) + " (problem '" + info.name + "')");
+    for (const auto* v : p.times)
+      if (v->number > t_end)
+        throw MatrixError(v->where, "times: " + v->text + " is beyond t_end " + format_short(t_end) +
+                                        " (problem '" + info.name + "')");
+    std::vector<StepSettings> settings;
+    if (integ.fixed_step) {
+      for (const auto* v : p.steps) {
+        if (v->number > t_end) {
+          note(p, info.name + ": step " + v->text + " larger than t_end " + format_short(t_end) + ": skipped");
+          continue;
+        }
+        settings.push_back({v->number, 0, 0});
+      }
+    } else if (!p.tols.empty()) {
+      for (const auto* v : p.tols) settings.push_back({0, v->number, v->number});
+    } else {
+      for (const auto* r : p.rtols)
+        for (const auto* a : p.atols) settings.push_back({0, r->number, a->number});
+    }
+    std::vector<size_t> pick(applying.size(), 0);
+    while (true) {
+      std::vector<std::pair<std::string, std::string>> params;
+      for (size_t i = 0; i < applying.size(); ++i)
+        params.emplace_back(applying[i]->name, format_short(applying[i]->values[pick[i]]->number));
+      for (const StepSettings& st : settings)
+        for (const double perturb : p.perturbs) add_case(p, info, method, form, integ, t_end, params, st, perturb);
+      size_t i = 0;
+      while (i < pick.size() && ++pick[i] == applying[i]->values.size()) pick[i++] = 0;
+      if (i == pick.size()) break;
+    }
+  }
+
+  // Stage 12: one case, unless an identical one is already in the expansion.
+  void add_case(const SweepPlan& p, const ProblemInfo& info, const MethodInfo& method, const std::string& form,
+                const IntegratorInfo& integ, double t_end, const std::vector<std::pair<std::string, std::string>>& params,
+                const StepSettings& st, double perturb) {
+    MatrixCase c;
+    RunConfig& cfg = c.config;
+    cfg.problem = info.name;
+    cfg.method = method.name;
+    cfg.formulation = form;
+    cfg.integrator = integ.name;
+    cfg.params = params;
+    cfg.step = st;
+    cfg.t_end = t_end;
+    for (const auto* v : p.times) cfg.times.push_back(v->number);
+    cfg.sample_every = p.sample_every;
+    cfg.ref_time = p.ref_time;
+    cfg.blowup = p.blowup;
+    cfg.observe_every = p.observe_every;
+    cfg.write_series = p.series;
+    cfg.perturb = perturb;
+    c.timeout = p.timeout;
+    c.repeat_if_under = p.repeat_if_under;
+    c.config_text = canonical_text(cfg, p.repeats, p.timeout, p.repeat_if_under);
+    CaseEntry& e = c.entry;
+    e.id = hash_hex(c.config_text);
+    if (!seen_ids_.insert(e.id).second) {
+      ++duplicates_;
+      return;
+    }
+    e.index = out_.cases.size();
+    e.sweep = p.name;
+    e.problem = cfg.problem;
+    e.method = cfg.method;
+    e.formulation = form;
+    e.integrator = cfg.integrator;
+    for (const auto& [k, v] : cfg.params) e.params += (e.params.empty() ? "" : ";") + k + "=" + v;
+    if (integ.fixed_step)
+      e.setting = "step=" + format_short(st.step);
+    else if (st.rtol == st.atol)
+      e.setting = "tol=" + format_short(st.rtol);
+    else
+      e.setting = "rtol=" + format_short(st.rtol) + ";atol=" + format_short(st.atol);
+    if (perturb > 0) e.setting += ";perturb=" + format_short(perturb);
+    e.t_end = t_end;
+    e.repeats = p.repeats;
+    e.work_precision = p.work_precision;
+    e.overlay = p.overlay;
+    e.curve = e.method + (form.empty() ? "" : "[" + form + "]") + "/" + e.integrator +
+              (e.params.empty() ? "" : " " + e.params);
+    c.cost_estimate = estimate_cost(cfg, integ, p.repeats);
+    out_.cases.push_back(std::move(c));
+  }
+
+  // Stage 13: the sweep's notes; a sweep without a case is an error (unless optional), naming why.
+  void finish_sweep(const SweepPlan& p, size_t notes_before, size_t cases_before, size_t duplicates_before) {
+    for (const auto& pc : p.params)
+      if (!pc.used && !p.optional)
+        note(p, "param." + (pc.method.empty() ? "" : pc.method + ".") + pc.name + " (line " +
+                    std::to_string(pc.where.line) + ") applies to no method of the sweep");
+    if (p.wrong_integrator)
+      note(p, std::to_string(p.wrong_integrator) + " method x integrator combinations skipped: DAE methods (ida-*) "
+              "need integrator 'ida', and 'ida' needs a DAE method");
+    if (out_.cases.size() == cases_before && duplicates_ == duplicates_before && !p.optional) {
+      std::string why;
+      for (size_t i = notes_before; i < out_.notes.size(); ++i) why += "; " + out_.notes[i];
+      throw MatrixError(p.sec->where, "sweep '" + p.name + "' expands to no case" +
+                                          (why.empty() ? std::string() : why));
+    }
+    if (p.not_applicable && (p.every_method || p.every_problem))
+      note(p, std::to_string(p.not_applicable) + " problem x method combinations do not apply (see `cstab list`)");
+  }
+
+  const MatrixCatalog& catalog_;
+  Expansion out_;
+  std::set<std::string> seen_ids_, seen_names_;
+  size_t duplicates_ = 0;
+  double planned_ = 0;  // upper bound of the cases so far
+};
+
+}  // namespace
+
+Expansion expand_matrix(const MatrixFile& file, const MatrixCatalog& catalog) { return Expander(catalog).run(file); }
 
 std::pair<int, int> parse_shard(const std::string& text) {
   const size_t slash = text.find('/');

@@ -1,10 +1,10 @@
 // The benchmark matrix: a declarative file of sweeps, expanded into cases,
 // each run (in a forked worker process) into DIR/cases/<case_id>/.
 //
-// File format (docs/matrix.md has the full reference): a strict subset of
-// TOML. Comments start with '#'. One optional [defaults] table, then any
-// number of [[sweep]] tables; every key of a sweep may be a single value or
-// an array, and a sweep is the Cartesian product of its arrays:
+// File format (docs/matrix.md has the full reference): TOML 1.0, read by
+// toml++. One optional [defaults] table, then any number of [[sweep]]
+// tables; every key of a sweep may be a single value or an array, and a
+// sweep is the Cartesian product of its arrays:
 //
 //     [defaults]
 //     repeats = 3
@@ -47,32 +47,38 @@ struct SourceLocation {
   std::string str() const;   // "file:line:column"
 };
 
-// A malformed or inconsistent matrix file; what() is "file:line:col: message".
+// A malformed or inconsistent matrix file; what() is "file:line:col: message"
+// (columns count UTF-8 code points, as toml++ does).
 struct MatrixError : UsageError {
   MatrixError(const SourceLocation& where, const std::string& message)
       : UsageError(where.str() + ": " + message) {}
 };
 
+// A value of the file: TOML integers and floats are numbers (always finite;
+// inf and nan are refused), dates and times and tables are refused.
 struct MatrixValue {
   enum class Kind { kString, kNumber, kBool, kArray };
   Kind kind = Kind::kString;
-  std::string text;  // string contents, or the number's source text
+  std::string text;  // string contents, or the number's source text ("1_000")
   double number = 0;
   bool boolean = false;
-  std::vector<MatrixValue> items;  // kArray (never nested)
+  std::vector<MatrixValue> items;  // kArray (never nested; kinds may mix)
   SourceLocation where;
 };
 
 struct MatrixEntry {
-  std::string key;  // dotted keys joined with '.', e.g. "param.lambda"
-  SourceLocation where;
+  // The path of nested tables down to the value joined with '.', whatever
+  // the TOML spelling: "param.lambda" for `param.lambda = ..`,
+  // `param = { lambda = .. }` or `lambda = ..` under [defaults.param].
+  std::string key;
+  SourceLocation where;  // the start of the key on its line
   MatrixValue value;
 };
 
 struct MatrixSection {
   std::string kind;  // "defaults" or "sweep"
   SourceLocation where;
-  std::vector<MatrixEntry> entries;
+  std::vector<MatrixEntry> entries;  // in file order
 };
 
 struct MatrixFile {
@@ -81,6 +87,9 @@ struct MatrixFile {
   std::vector<MatrixSection> sections;
 };
 
+// Throws MatrixError: for a TOML syntax error (toml++'s message) or what a
+// matrix file cannot hold (a key outside a section, another section, a
+// date, a nested array, inf/nan, a key part that is not a bare key).
 MatrixFile parse_matrix(const std::string& text, const std::string& file_name);
 MatrixFile read_matrix_file(const std::string& path);  // throws UsageError if unreadable
 

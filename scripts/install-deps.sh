@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Installs the Debian 12 packages cstab needs (plus any given as arguments), only those missing.
 set -euo pipefail
-packages=(g++ cmake make libeigen3-dev libsundials-dev libgsl-dev libbenchmark-dev libfccp-dev
+packages=(g++ cmake make libeigen3-dev libsundials-dev libgsl-dev libbenchmark-dev libfccp-dev libtomlplusplus-dev
           gnuplot-nox googletest libgtest-dev libcli11-dev parallel "$@")
 missing=()
 for p in "${packages[@]}"; do
