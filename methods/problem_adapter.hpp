@@ -7,6 +7,7 @@
 #pragma once
 
 #include <memory>
+#include <stdexcept>
 #include <string>
 #include <utility>
 #include <vector>
@@ -24,7 +25,9 @@ class ProblemAdapter final : public Problem {
 
  public:
   ProblemAdapter(P problem, std::vector<PairOps> pairs)
-      : p_(std::move(problem)), info_(p_.info()), pairs_(std::move(pairs)) {}
+      : p_(std::move(problem)), info_(p_.info()), pairs_(std::move(pairs)) {
+    check_info_against_class();
+  }
 
   const ProblemInfo& info() const override { return info_; }
 
@@ -76,6 +79,23 @@ class ProblemAdapter final : public Problem {
     const std::string why = why_not(method);
     if (!why.empty()) throw UsageError("--method " + method + ": does not apply to problem '" +
                                        info_.name + "': " + why);
+  }
+
+  // What info() promises that only run time can compare with the class:
+  // without these a problem claiming an energy law but lacking energy()
+  // would report max |dE| = 0 for every run.
+  void check_info_against_class() const {
+    const std::string who = "problem '" + info_.name + "': ";
+    if (info_.has_energy && !contracts::HasEnergy<P>)
+      throw std::logic_error(who + "info().has_energy is true but the class has no "
+                                   "`double energy(double t, const double* canonical) const`");
+    if (!info_.first_integrals.empty() && !contracts::HasFirstIntegrals<P>)
+      throw std::logic_error(who + "info().first_integrals names " + std::to_string(info_.first_integrals.size()) +
+                             " but the class has no `void first_integrals(double t, const double* canonical, "
+                             "double* out) const`");
+    if (info_.reference_time > 0 && !contracts::HasReference<P>)
+      throw std::logic_error(who + "info().reference_time > 0 but the class has no "
+                                   "`bool reference(double t, double* canonical) const`");
   }
 
   P p_;
