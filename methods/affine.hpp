@@ -2,13 +2,18 @@
 //     X' = F(t, X) + B(t, X) N,   outputs f_i(t, X) = 0, i = 1..m,
 // with N the m unknown reactions and r_i the relative degree of output i.
 //
-// A model type provides (sizes fixed at compile time):
+// A model type provides (sizes fixed at compile time; the concept
+// contracts::AffineModel in methods/contracts.hpp checks it):
 //   static constexpr int kStates, kInputs;
-//   static constexpr std::array<int, kInputs> kRelativeDegree;
+//   static constexpr std::array<int, kInputs> kRelativeDegree;   // each >= 1
 //   template <class S> void drift(const S& t, const Vec<S, kStates>& X, Vec<S, kStates>& F) const;
-//   void input_matrix(double t, const Vec<double, kStates>& X, Mat<kStates, kInputs>& B) const;
+//   void input_matrix(double t, const Vec<double, kStates>& X, Eigen::Matrix<double, kStates, kInputs>& B) const;
 //   template <class S> void outputs(const S& t, const Vec<S, kStates>& X, Vec<S, kInputs>& f) const;
-// and the observables listed in AffineModelObservables below.
+//   std::string formulation_name() const;
+//   std::vector<ConstraintInfo> constraints() const;               // one per output
+//   void initial_state(Vec<double, kStates>& X) const;
+//   void to_canonical(double t, const Vec<double, kStates>& X, double* canonical) const;
+// and optionally closed_form_jet (LieJet below).
 //
 // LieJet computes, by nested forward-mode AD, everything lambda-feedback
 // needs: L_F^k f_i for k < r_i, the rows A_i = L_B L_F^{r_i-1} f_i and
@@ -26,8 +31,21 @@
 #include "core/formulation.hpp"
 #include "core/vec.hpp"
 #include "linalg/dense.hpp"
+#include "methods/contract_detail.hpp"
 
 namespace cstab {
+
+template <class Model>
+class LieJet;
+
+namespace contracts::detail {
+// The exact call LieJet makes of the optional closed-form jet.
+template <class M>
+inline constexpr bool closed_form_jet_exact =
+    requires(const M& m, double t, const Vec<double, M::kStates>& X, LieJet<M>& jet) {
+      m.closed_form_jet(t, X, jet);
+    };
+}  // namespace contracts::detail
 
 template <class Model>
 class LieJet {
@@ -49,9 +67,15 @@ class LieJet {
   // A model may provide the jet in closed form,
   //   template <class Jet> void closed_form_jet(double t, const Vec<double, n>& X, Jet& jet) const;
   // filling F, B, A, top and lower as evaluate_ad would (a hand-derived fast
-  // path: its test compares it with evaluate_ad). Otherwise nested AD.
+  // path: its test compares it with evaluate_ad). Otherwise nested AD. A
+  // member named closed_form_jet with another signature is an error.
+  static constexpr bool has_closed_form() {
+    constexpr bool exact = contracts::detail::closed_form_jet_exact<Model>;
+    static_assert(exact || !contracts::detail::names_closed_form_jet<Model>, CSTAB_CONTRACT_MSG_CLOSED_FORM_JET);
+    return exact;
+  }
   void evaluate(const Model& model, double t, const Vec<double, n>& X) {
-    if constexpr (requires { model.closed_form_jet(t, X, *this); })
+    if constexpr (has_closed_form())
       model.closed_form_jet(t, X, *this);
     else
       evaluate_ad(model, t, X);

@@ -4,7 +4,9 @@
 //     non-holonomic  Psi(t, q, v) = G(t, q) v + g(t, q) = 0 (kNonholonomic rows)
 //     energy law     E(t, q, v) = E(0)                  (if kHasEnergy)
 //
-// A model type provides (sizes fixed at compile time):
+// A model type provides (sizes fixed at compile time; the concept
+// contracts::MechanicalModel in methods/contracts.hpp checks it, with
+// S = double and AD scalars):
 //   static constexpr int kCoords, kHolonomic, kNonholonomic;
 //   static constexpr bool kHasEnergy;
 //   std::string formulation_name() const;
@@ -33,6 +35,9 @@
 //                                                       const Vec<double,nq>& v, Terms& terms) const;
 // setting the last nn entries of terms.velocity (Psi), rows nh.. of terms.A
 // (G = dPsi/dv) and the last nn entries of terms.gamma (dPsi/dq v + dPsi/dt).
+// A member named closed_form_holonomic / closed_form_nonholonomic that does
+// not match these exactly (signature, constness) is a compile error, not a
+// silent fall-back to AD.
 #pragma once
 
 #include <string>
@@ -42,8 +47,27 @@
 #include "core/formulation.hpp"
 #include "linalg/dense.hpp"
 #include "methods/affine.hpp"
+#include "methods/contract_detail.hpp"
 
 namespace cstab {
+
+template <class Model>
+struct MechanicalTerms;
+
+namespace contracts::detail {
+// The exact calls MechanicalTerms makes of the optional closed forms.
+template <class M>
+inline constexpr bool closed_form_holonomic_exact =
+    requires(const M& m, double t, const Vec<double, M::kCoords>& q, MechanicalTerms<M>& terms) {
+      m.closed_form_holonomic(t, q, &q, terms);
+      m.closed_form_holonomic(t, q, static_cast<const Vec<double, M::kCoords>*>(nullptr), terms);
+    };
+template <class M>
+inline constexpr bool closed_form_nonholonomic_exact =
+    requires(const M& m, double t, const Vec<double, M::kCoords>& q, MechanicalTerms<M>& terms) {
+      m.closed_form_nonholonomic(t, q, q, terms);
+    };
+}  // namespace contracts::detail
 
 template <class Model>
 struct MechanicalTerms {
@@ -70,15 +94,19 @@ struct MechanicalTerms {
 
   // Forces AD where the model has a closed form (tests compare the two).
   bool use_ad = false;
+  // A member named like a closed form but callable otherwise is an error,
+  // not a silent fall-back to AD (methods/contract_detail.hpp).
   static constexpr bool has_closed_form() {
-    return requires(const Model& m, const VecQ& q, MechanicalTerms& terms) {
-      m.closed_form_holonomic(0.0, q, &q, terms);
-    };
+    constexpr bool exact = contracts::detail::closed_form_holonomic_exact<Model>;
+    static_assert(exact || !contracts::detail::names_closed_form_holonomic<Model>,
+                  CSTAB_CONTRACT_MSG_CLOSED_FORM_HOLONOMIC);
+    return exact;
   }
   static constexpr bool has_closed_form_nonholonomic() {
-    return requires(const Model& m, const VecQ& q, MechanicalTerms& terms) {
-      m.closed_form_nonholonomic(0.0, q, q, terms);
-    };
+    constexpr bool exact = contracts::detail::closed_form_nonholonomic_exact<Model>;
+    static_assert(exact || !contracts::detail::names_closed_form_nonholonomic<Model>,
+                  CSTAB_CONTRACT_MSG_CLOSED_FORM_NONHOLONOMIC);
+    return exact;
   }
 
   // Positions only (projection needs no forces): phi, J (rows 0..nh), phi_t.
@@ -258,8 +286,8 @@ int initial_constraint_rank(const Model& model, int* rows) {
   }
 }
 
-// Shared applicability check for methods that run on P::mechanical().
-template <class P>
-concept HasMechanical = requires(const P& p) { p.mechanical(); };
+// The applicability check of the methods that run on P::mechanical() is
+// contracts::HasMechanical (methods/contracts.hpp): a mechanical() whose
+// model satisfies MechanicalModel.
 
 }  // namespace cstab

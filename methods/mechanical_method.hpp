@@ -1,5 +1,8 @@
 // Registry plumbing shared by the methods that run on a problem's
-// mechanical model (P::mechanical()).
+// mechanical model (P::mechanical()). A method derived from it provides
+// kName, kDescription, generic_params() and
+//   template <class Model> static std::unique_ptr<Formulation> make_model(const Model&, const Params&);
+// and may replace why_not_model / model_params (defaults below).
 #pragma once
 
 #include <memory>
@@ -8,6 +11,7 @@
 
 #include "core/params.hpp"
 #include "core/problem.hpp"
+#include "methods/contracts.hpp"
 #include "methods/mechanical.hpp"
 
 namespace cstab {
@@ -16,7 +20,8 @@ template <class Derived>
 struct MechanicalMethod {
   template <class P>
   static std::string why_not(const P& p) {
-    if constexpr (HasMechanical<P>) {
+    static_assert(contracts::check_problem<P>());
+    if constexpr (contracts::HasMechanical<P>) {
       return Derived::template why_not_model(p.mechanical());
     } else {
       return "problem has no mechanical (M, Q, constraints) model";
@@ -25,8 +30,9 @@ struct MechanicalMethod {
 
   template <class P>
   static std::vector<ParamSpec> params(const P& p, const std::string& formulation) {
+    static_assert(contracts::check_problem<P>());
     check_formulation(p, formulation);
-    if constexpr (HasMechanical<P>) {
+    if constexpr (contracts::HasMechanical<P>) {
       return Derived::template model_params(p.mechanical());
     } else {
       return {};
@@ -35,8 +41,9 @@ struct MechanicalMethod {
 
   template <class P>
   static std::unique_ptr<Formulation> make(const P& p, const std::string& formulation, const Params& params) {
+    static_assert(contracts::check_problem<P>());
     check_formulation(p, formulation);
-    if constexpr (HasMechanical<P>) {
+    if constexpr (contracts::HasMechanical<P>) {
       return Derived::template make_model(p.mechanical(), params);
     } else {
       throw UsageError(std::string(Derived::kName) + ": problem has no mechanical model");
@@ -52,7 +59,7 @@ struct MechanicalMethod {
  private:
   template <class P>
   static void check_formulation(const P& p, const std::string& formulation) {
-    if constexpr (HasMechanical<P>) {
+    if constexpr (contracts::HasMechanical<P>) {
       if (!formulation.empty() && formulation != p.mechanical().formulation_name())
         throw UsageError("--formulation " + formulation + ": " + Derived::kName + " runs on '" +
                          p.mechanical().formulation_name() + "'");

@@ -3,11 +3,16 @@
 // baseline every stabilization method is compared against (issue 8), and
 // the reference formulation for the problem's accuracy checks.
 //
-// A minimal model provides: static constexpr int kStates;
+// A minimal model provides (contracts::MinimalModel, methods/contracts.hpp):
+//   static constexpr int kStates;
+//   std::string formulation_name() const;
+//   std::vector<ConstraintInfo> constraints() const;
+//   void initial_state(Vec<double,kStates>& y) const;
 //   bool rhs(double t, const Vec<double,kStates>& y, Vec<double,kStates>& dy) const;
-//   initial_state(Vec&), to_canonical(t, y, double*), formulation_name(),
-//   constraints(), residuals(t, y, double*) (the problem's constraints
-//   evaluated on the mapped state: round-off level by construction).
+//   void to_canonical(double t, const Vec<double,kStates>& y, double* canonical) const;
+//   void residuals(double t, const Vec<double,kStates>& y, double* out) const;
+//     (the problem's constraints evaluated on the mapped state: round-off
+//     level by construction).
 #pragma once
 
 #include <memory>
@@ -17,6 +22,7 @@
 #include "core/formulation.hpp"
 #include "core/params.hpp"
 #include "methods/affine.hpp"
+#include "methods/contracts.hpp"
 
 namespace cstab {
 
@@ -61,7 +67,8 @@ struct MinimalMethod {
 
   template <class P>
   static std::string why_not(const P&) {
-    if constexpr (requires(const P& p) { p.minimal(); }) {
+    static_assert(contracts::check_problem<P>());
+    if constexpr (contracts::HasMinimal<P>) {
       return {};
     } else {
       return "problem has no minimal-coordinate formulation";
@@ -69,7 +76,8 @@ struct MinimalMethod {
   }
   template <class P>
   static std::vector<ParamSpec> params(const P& p, const std::string& formulation) {
-    if constexpr (requires { p.minimal(); }) {
+    static_assert(contracts::check_problem<P>());
+    if constexpr (contracts::HasMinimal<P>) {
       if (!formulation.empty() && formulation != p.minimal().formulation_name())
         throw UsageError("--formulation " + formulation + ": minimal runs on '" +
                          p.minimal().formulation_name() + "'");
@@ -78,8 +86,9 @@ struct MinimalMethod {
   }
   template <class P>
   static std::unique_ptr<Formulation> make(const P& p, const std::string& formulation, const Params&) {
+    static_assert(contracts::check_problem<P>());
     params(p, formulation);
-    if constexpr (requires { p.minimal(); }) {
+    if constexpr (contracts::HasMinimal<P>) {
       using Model = std::decay_t<decltype(p.minimal())>;
       return std::make_unique<MinimalFormulation<Model>>(p.minimal());
     } else {

@@ -3,7 +3,8 @@
 // generates (cmake/cstab_catalog.cmake): the build grows with the sum of
 // methods and problems, and touching a method recompiles only its pairs.
 //
-// A method type M provides (see docs/extending.md):
+// A method type M provides (contracts::MethodType / MethodFor in
+// methods/contracts.hpp; see docs/extending.md):
 //   static constexpr const char* kName, kDescription;
 //   static std::vector<ParamSpec> generic_params();   // gains declare their ParamRole
 //   static constexpr bool kIsDae;                       // optional, default false
@@ -22,29 +23,55 @@
 
 namespace cstab {
 
+// The contract checks (methods/contracts.hpp). Declared here so that this
+// header stays light for cli/; every method header includes their
+// definitions, and pair_ops / method_info are only instantiated after one.
+namespace contracts {
+template <class M, class P>
+constexpr bool check_pair();
+template <class M, class P>
+constexpr bool pair_ok();
+template <class M>
+constexpr bool check_method();
+template <class M>
+constexpr bool method_ok();
+}  // namespace contracts
+
 struct PairOps {
   std::string (*why_not)(const void* problem);
   std::vector<ParamSpec> (*params)(const void* problem, const std::string& formulation);
   std::unique_ptr<Formulation> (*make)(const void* problem, const std::string& formulation, const Params& params);
 };
 
+// The contracts are checked first: a broken problem or method is a list of
+// one-line static_asserts, and nothing of the pair is instantiated.
 template <class M, class P>
 PairOps pair_ops() {
-  return {
-      [](const void* p) { return M::why_not(*static_cast<const P*>(p)); },
-      [](const void* p, const std::string& f) { return M::params(*static_cast<const P*>(p), f); },
-      [](const void* p, const std::string& f, const Params& prm) {
-        return M::make(*static_cast<const P*>(p), f, prm);
-      },
-  };
+  static_assert(contracts::check_pair<M, P>());
+  if constexpr (contracts::pair_ok<M, P>()) {
+    return {
+        [](const void* p) { return M::why_not(*static_cast<const P*>(p)); },
+        [](const void* p, const std::string& f) { return M::params(*static_cast<const P*>(p), f); },
+        [](const void* p, const std::string& f, const Params& prm) {
+          return M::make(*static_cast<const P*>(p), f, prm);
+        },
+    };
+  } else {
+    return {nullptr, nullptr, nullptr};
+  }
 }
 
 template <class M>
 MethodInfo method_info() {
-  MethodInfo info{M::kName, M::kDescription, M::generic_params()};
-  if constexpr (requires { M::kIsDae; }) info.is_dae = M::kIsDae;
-  if constexpr (requires { M::conformance(); }) info.conformance = M::conformance();
-  return info;
+  static_assert(contracts::check_method<M>());
+  if constexpr (contracts::method_ok<M>()) {
+    MethodInfo info{M::kName, M::kDescription, M::generic_params()};
+    if constexpr (requires { M::kIsDae; }) info.is_dae = M::kIsDae;
+    if constexpr (requires { M::conformance(); }) info.conformance = M::conformance();
+    return info;
+  } else {
+    return {};
+  }
 }
 
 // The methods in the build, in the catalog's order (generated).

@@ -15,6 +15,7 @@
 #include "core/params.hpp"
 #include "core/problem.hpp"
 #include "methods/affine.hpp"
+#include "methods/contracts.hpp"
 #include "methods/mechanical.hpp"
 #include "linalg/small_linalg.hpp"
 
@@ -180,7 +181,8 @@ struct PesterevMethod {
 
   template <class P>
   static std::string why_not(const P&) {
-    if constexpr (requires(const P& p) { p.state_space(); } || HasMechanical<P>) {
+    static_assert(contracts::check_problem<P>());
+    if constexpr (contracts::HasStateSpace<P> || contracts::HasMechanical<P>) {
       return {};
     } else {
       return "problem has neither an affine (state-space) nor a mechanical model";
@@ -189,6 +191,7 @@ struct PesterevMethod {
 
   template <class P>
   static std::vector<ParamSpec> params(const P& p, const std::string& formulation) {
+    static_assert(contracts::check_problem<P>());
     auto specs = generic_params();
     for (const auto& c : constraints_of(p, formulation))
       specs.push_back({"lambda_" + c.name, 0, Bound::kNonNegative,
@@ -198,13 +201,14 @@ struct PesterevMethod {
 
   template <class P>
   static std::unique_ptr<Formulation> make(const P& p, const std::string& formulation, const Params& params) {
-    if constexpr (requires { p.state_space(); }) {
+    static_assert(contracts::check_problem<P>());
+    if constexpr (contracts::HasStateSpace<P>) {
       if (formulation.empty() || formulation == p.state_space().formulation_name()) {
         using Model = std::decay_t<decltype(p.state_space())>;
         return std::make_unique<PesterevFormulation<Model>>(p.state_space(), params);
       }
     }
-    if constexpr (HasMechanical<P>) {
+    if constexpr (contracts::HasMechanical<P>) {
       if (formulation.empty() || formulation == p.mechanical().formulation_name()) {
         using Model = std::decay_t<decltype(p.mechanical())>;
         return std::make_unique<PesterevMechanicalFormulation<Model>>(p.mechanical(), params);
@@ -216,11 +220,11 @@ struct PesterevMethod {
  private:
   template <class P>
   static std::vector<ConstraintInfo> constraints_of(const P& p, const std::string& formulation) {
-    if constexpr (requires { p.state_space(); }) {
+    if constexpr (contracts::HasStateSpace<P>) {
       if (formulation.empty() || formulation == p.state_space().formulation_name())
         return p.state_space().constraints();
     }
-    if constexpr (HasMechanical<P>) {
+    if constexpr (contracts::HasMechanical<P>) {
       if (formulation.empty() || formulation == p.mechanical().formulation_name())
         return p.mechanical().constraints();
     }

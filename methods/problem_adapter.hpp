@@ -1,15 +1,19 @@
 // Adapts a concrete problem class (problems/<name>/) to the runtime Problem
 // interface. Its methods come as a table of PairOps, one per entry of
 // all_methods(), each compiled in its own translation unit; a method that
-// does not apply says why (why_not), nothing is silently skipped.
+// does not apply says why (why_not), nothing is silently skipped. P must
+// satisfy contracts::ProblemClass (methods/contracts.hpp): a broken problem
+// or model is a compile error here, before anything else of it is built.
 #pragma once
 
 #include <memory>
+#include <stdexcept>
 #include <string>
 #include <utility>
 #include <vector>
 
 #include "core/problem.hpp"
+#include "methods/contracts.hpp"
 #include "methods/pair.hpp"
 #include "methods/unconstrained.hpp"
 
@@ -17,9 +21,13 @@ namespace cstab {
 
 template <class P>
 class ProblemAdapter final : public Problem {
+  static_assert(contracts::check_problem<P>());
+
  public:
   ProblemAdapter(P problem, std::vector<PairOps> pairs)
-      : p_(std::move(problem)), info_(p_.info()), pairs_(std::move(pairs)) {}
+      : p_(std::move(problem)), info_(p_.info()), pairs_(std::move(pairs)) {
+    check_info_against_class();
+  }
 
   const ProblemInfo& info() const override { return info_; }
 
@@ -40,24 +48,26 @@ class ProblemAdapter final : public Problem {
   }
 
   std::unique_ptr<Formulation> make_unconstrained() const override {
-    if constexpr (HasMechanical<P>) {
+    if constexpr (contracts::HasMechanical<P>) {
       return std::make_unique<UnconstrainedMechanical<std::decay_t<decltype(p_.mechanical())>>>(p_.mechanical());
-    } else if constexpr (requires { p_.state_space(); }) {
+    } else if constexpr (contracts::HasStateSpace<P>) {
       return std::make_unique<UnconstrainedAffine<std::decay_t<decltype(p_.state_space())>>>(p_.state_space());
     } else {
       return nullptr;
     }
   }
 
+  // The optional observables: used when declared with the exact signature
+  // (a member of that name with another one does not compile, see above).
   double energy(double t, const double* c) const override {
-    if constexpr (requires { p_.energy(t, c); }) return p_.energy(t, c);
+    if constexpr (contracts::HasEnergy<P>) return p_.energy(t, c);
     return 0;
   }
   void first_integrals(double t, const double* c, double* out) const override {
-    if constexpr (requires { p_.first_integrals(t, c, out); }) p_.first_integrals(t, c, out);
+    if constexpr (contracts::HasFirstIntegrals<P>) p_.first_integrals(t, c, out);
   }
   bool reference(double t, double* c) const override {
-    if constexpr (requires { p_.reference(t, c); }) return p_.reference(t, c);
+    if constexpr (contracts::HasReference<P>) return p_.reference(t, c);
     return false;
   }
 
@@ -69,6 +79,23 @@ class ProblemAdapter final : public Problem {
     const std::string why = why_not(method);
     if (!why.empty()) throw UsageError("--method " + method + ": does not apply to problem '" +
                                        info_.name + "': " + why);
+  }
+
+  // What info() promises that only run time can compare with the class:
+  // without these a problem claiming an energy law but lacking energy()
+  // would report max |dE| = 0 for every run.
+  void check_info_against_class() const {
+    const std::string who = "problem '" + info_.name + "': ";
+    if (info_.has_energy && !contracts::HasEnergy<P>)
+      throw std::logic_error(who + "info().has_energy is true but the class has no "
+                                   "`double energy(double t, const double* canonical) const`");
+    if (!info_.first_integrals.empty() && !contracts::HasFirstIntegrals<P>)
+      throw std::logic_error(who + "info().first_integrals names " + std::to_string(info_.first_integrals.size()) +
+                             " but the class has no `void first_integrals(double t, const double* canonical, "
+                             "double* out) const`");
+    if (info_.reference_time > 0 && !contracts::HasReference<P>)
+      throw std::logic_error(who + "info().reference_time > 0 but the class has no "
+                                   "`bool reference(double t, double* canonical) const`");
   }
 
   P p_;
