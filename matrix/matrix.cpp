@@ -897,13 +897,8 @@ class Expander {
       return;
     }
     // A DAE formulation F(t, y, y') = 0 needs a DAE integrator and an
-    // ODE one an ODE integrator: impossible pairs are not cases.
-    int is_dae = -1;  // -1: unknown (the formulation cannot be built with defaults)
-    try {
-      const auto f = problem.make(method.name, "", Params::resolve(specs, {}, method.name));
-      if (f) is_dae = dynamic_cast<const DaeSystem*>(f.get()) != nullptr;
-    } catch (const UsageError&) {
-    }
+    // ODE one an ODE integrator (the method declares which it is,
+    // MethodInfo::is_dae): impossible pairs are not cases.
     const std::vector<ParamChoice*> applying = applying_params(p, info, method, specs);
     std::vector<std::string> forms;
     for (const auto* f : p.formulations) forms.push_back(f->text);
@@ -919,7 +914,7 @@ class Expander {
         }
       }
       for (const IntegratorInfo* integ : p.integrators) {
-        if (is_dae >= 0 && bool(is_dae) != integ->solves_dae) {
+        if (method.is_dae != integ->solves_dae) {
           ++p.wrong_integrator;
           continue;
         }

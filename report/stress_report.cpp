@@ -1,5 +1,7 @@
 #include "report/stress_report.hpp"
 
+#include "methods/pair.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -25,13 +27,20 @@ double first_wall(const CaseResult& c) { return c.repeats.empty() ? kNaN : c.rep
 // A row's class: none if ok, "div" (highlighted) otherwise.
 const char* row_class(bool ok) { return ok ? "" : " class=\"div\""; }
 
-// The gain of a stiffness case: its lambda, else alpha (baumgarte), else dt.
-double gain_of(const std::string& params) {
-  for (const char* key : {"lambda=", "alpha="}) {
+// The gain of a stiffness case: the value of the parameter its method
+// declares as its gain (ParamSpec::role); NaN for a method without one, or
+// one this binary does not know.
+double gain_of(const CaseEntry& e) {
+  for (const MethodInfo& m : all_methods()) {
+    if (m.name != e.method) continue;
+    const ParamSpec* gain = find_gain(m.params);
+    if (!gain) return kNaN;
+    const std::string key = gain->name + "=";
+    const std::string& params = e.params;
     const size_t at = params.find(key);
-    if (at != std::string::npos && (at == 0 || params[at - 1] == ';'))
-      return parse_number(
-          params.substr(at + std::string(key).size(), params.find(';', at) - at - std::string(key).size()));
+    if (at == std::string::npos || (at != 0 && params[at - 1] != ';')) return kNaN;
+    const size_t from = at + key.size();
+    return parse_number(params.substr(from, params.find(';', at) - from));
   }
   return kNaN;
 }
@@ -261,7 +270,7 @@ StiffCurves write_stiff_csv(const std::string& dir, const Cases& stiff) {
                     "rhs_evals,ref_error,max_residual,case_id\n";
   StiffCurves curves;
   for (const CaseResult* c : stiff) {
-    const double g = gain_of(c->entry->params);
+    const double g = gain_of(*c->entry);
     csv += csv_line({c->entry->problem, c->entry->method, c->formulation, c->entry->integrator, c->entry->setting,
                      std::isnan(g) ? "" : format_short(g), status_name(c->status), c->reason,
                      number_cell(first_wall(*c)), count_cell(c->steps), count_cell(c->rhs_evals),
@@ -289,15 +298,15 @@ void stiff_section(std::ostream& h, const std::string& dir, const Cases& stiff, 
   for (const auto& curve : curves.names) {
     Cases rows = curves.of[curve];
     std::stable_sort(rows.begin(), rows.end(), [](const CaseResult* a, const CaseResult* b) {
-      return gain_of(a->entry->params) < gain_of(b->entry->params);
+      return gain_of(*a->entry) < gain_of(*b->entry);
     });
     for (const CaseResult* c : rows)
       h << "<tr" << row_class(c->status == Status::kOk) << "><td>" << html_escape(curve)
-        << "</td><td class=\"num\">" << sci(gain_of(c->entry->params)) << "</td><td>"
+        << "</td><td class=\"num\">" << sci(gain_of(*c->entry)) << "</td><td>"
         << html_escape(status_name(c->status)) << "</td><td class=\"num\">" << sci(first_wall(*c))
         << "</td><td class=\"num\">" << html_escape(count_cell(c->steps)) << "</td><td class=\"num\">"
         << sci(c->ref_error) << "</td><td class=\"num\">" << sci(c->max_residual) << "</td></tr>\n";
-    if (std::isnan(gain_of(rows[0]->entry->params))) continue;  // no gain axis
+    if (std::isnan(gain_of(*rows[0]->entry))) continue;  // no gain axis
     if (blocks++) data += "\n\n";
     data += gnuplot_data_title(curve.substr(curve.find(": ") + 2)) + " wall_seconds ref_error max_residual\n";
     lcs += ' ';
@@ -305,7 +314,7 @@ void stiff_section(std::ostream& h, const std::string& dir, const Cases& stiff, 
     for (const CaseResult* c : rows) {
       const bool ok = c->status == Status::kOk;
       has_ref = has_ref || (ok && c->ref_error > 0);
-      data += format_exact(gain_of(c->entry->params)) + " " + (ok ? log_plot_cell(first_wall(*c)) : "?") + " " +
+      data += format_exact(gain_of(*c->entry)) + " " + (ok ? log_plot_cell(first_wall(*c)) : "?") + " " +
               (ok ? log_plot_cell(c->ref_error) : "?") + " " + (ok ? log_plot_cell(c->max_residual) : "?") + "\n";
     }
   }

@@ -3,6 +3,7 @@
 // constrained accelerations against a full-pivoting LU of the KKT system.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <random>
 
 #include "linalg/small_linalg.hpp"
@@ -19,6 +20,14 @@ Eigen::Matrix<double, N, N> random_spd(std::mt19937& rng) {
   return B * B.transpose() + 0.1 * Eigen::Matrix<double, N, N>::Identity();
 }
 
+// |a - b| for a fixed-size and a dynamic-size vector of the same length.
+template <class A, class B>
+double distance(const A& a, const B& b) {
+  double sum = 0;
+  for (int i = 0; i < int(a.size()); ++i) sum += (a(i) - b(i)) * (a(i) - b(i));
+  return std::sqrt(sum);
+}
+
 template <int N>
 void check_cholesky() {
   std::mt19937 rng(N);
@@ -27,23 +36,38 @@ void check_cholesky() {
     const Eigen::Matrix<double, N, 1> b = Eigen::Matrix<double, N, 1>::Random();
     SmallCholesky<N> chol;
     ASSERT_TRUE(chol.factor(M));
-    const Eigen::LLT<Eigen::Matrix<double, N, N>> llt(M);
-    const Eigen::Matrix<double, N, N> L = llt.matrixL();
+    // References on dynamic sizes: compiled once, not once per N.
+    const Eigen::MatrixXd Md = M;
+    const Eigen::VectorXd bd = b;
+    const Eigen::LLT<Eigen::MatrixXd> llt(Md);
+    const Eigen::MatrixXd L = llt.matrixL();
     EXPECT_LT((chol.L().template triangularView<Eigen::Lower>().toDenseMatrix() - L).norm(), 1e-12 * L.norm());
-    EXPECT_LT((chol.solve(b) - llt.solve(b)).norm(), 1e-10 * llt.solve(b).norm());
-    EXPECT_LT((chol.solve_lower(b) - llt.matrixL().solve(b)).norm(), 1e-10 * b.norm() * 1e3);
-    EXPECT_LT((chol.solve_upper(b) - llt.matrixU().solve(b)).norm(), 1e-10 * llt.matrixU().solve(b).norm());
+    const Eigen::VectorXd x = llt.solve(bd), xl = llt.matrixL().solve(bd), xu = llt.matrixU().solve(bd);
+    EXPECT_LT(distance(chol.solve(b), x), 1e-10 * x.norm());
+    EXPECT_LT(distance(chol.solve_lower(b), xl), 1e-10 * b.norm() * 1e3);
+    EXPECT_LT(distance(chol.solve_upper(b), xu), 1e-10 * xu.norm());
     // pivot ratio bounds 1 / cond_2 from above
-    Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, N, N>> eig(M);
+    Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(Md);
     EXPECT_GE(chol.pivot_ratio(), eig.eigenvalues()(0) / eig.eigenvalues()(N - 1) * (1 - 1e-12));
   }
 }
 
 TEST(SmallCholesky, MatchesEigenLlt) {
-  check_cholesky<1>();
+  check_cholesky<2>();
   check_cholesky<4>();
   check_cholesky<9>();
   check_cholesky<12>();
+}
+
+// 1 x 1 (the Schur complement of a single constraint row) in closed form.
+TEST(SmallCholesky, OneByOne) {
+  SmallCholesky<1> chol;
+  ASSERT_TRUE(chol.factor(Eigen::Matrix<double, 1, 1>(4.0)));
+  EXPECT_DOUBLE_EQ(chol.L()(0, 0), 2.0);
+  EXPECT_DOUBLE_EQ(chol.solve(Eigen::Matrix<double, 1, 1>(2.0))(0), 0.5);
+  EXPECT_DOUBLE_EQ(chol.solve_lower(Eigen::Matrix<double, 1, 1>(2.0))(0), 1.0);
+  EXPECT_DOUBLE_EQ(chol.solve_upper(Eigen::Matrix<double, 1, 1>(2.0))(0), 1.0);
+  EXPECT_DOUBLE_EQ(chol.pivot_ratio(), 1.0);
 }
 
 TEST(SmallCholesky, RefusesIndefiniteAndSingular) {
@@ -70,13 +94,15 @@ void check_schur() {
     const Eigen::Matrix<double, NQ, 1> Q = Eigen::Matrix<double, NQ, 1>::Random();
     const Eigen::Matrix<double, NC, 1> g = Eigen::Matrix<double, NC, 1>::Random();
     // KKT: [M -A^T; A 0] [a; N] = [Q; -g]  (M a = Q + A^T N, A a + g = 0)
-    Eigen::Matrix<double, NQ + NC, NQ + NC> K = Eigen::Matrix<double, NQ + NC, NQ + NC>::Zero();
-    K.template topLeftCorner<NQ, NQ>() = M;
-    K.template topRightCorner<NQ, NC>() = -A.transpose();
-    K.template bottomLeftCorner<NC, NQ>() = A;
-    Eigen::Matrix<double, NQ + NC, 1> rhs;
+    // The reference KKT solve on dynamic sizes (compiled once).
+    Eigen::MatrixXd K = Eigen::MatrixXd::Zero(NQ + NC, NQ + NC);
+    K.topLeftCorner(NQ, NQ) = M;
+    K.topRightCorner(NQ, NC) = -A.transpose();
+    K.bottomLeftCorner(NC, NQ) = A;
+    Eigen::VectorXd rhs(NQ + NC);
     rhs << Q, -g;
-    const Eigen::Matrix<double, NQ + NC, 1> x = K.fullPivLu().solve(rhs);
+    const Eigen::VectorXd xd = K.fullPivLu().solve(rhs);
+    const Eigen::Matrix<double, NQ + NC, 1> x = xd;
 
     SCOPED_TRACE(::testing::Message() << "NQ " << NQ << " NC " << NC << " trial " << trial);
     SchurSolver<NQ, NC> s;
@@ -86,7 +112,7 @@ void check_schur() {
     const Eigen::Matrix<double, NQ, 1> a = a_free + s.reaction_acceleration(N);
     EXPECT_LT((a - x.template head<NQ>()).norm(), 1e-9 * (1 + x.norm()));
     EXPECT_LT((N - x.template tail<NC>()).norm(), 1e-9 * (1 + x.norm()));
-    EXPECT_LT((s.schur() - A * M.inverse() * A.transpose()).norm(), 1e-10 * s.schur().norm());
+    EXPECT_LT((s.schur() - A * Eigen::MatrixXd(M).inverse() * A.transpose()).norm(), 1e-10 * s.schur().norm());
     // The two-substitution path the methods use.
     Eigen::Matrix<double, NC, 1> N2;
     const Eigen::Matrix<double, NQ, 1> a2 = s.accelerations(Q, g, &N2);
