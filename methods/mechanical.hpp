@@ -109,63 +109,18 @@ struct MechanicalTerms {
     return exact;
   }
 
+  // The evaluations are defined below the class, out of line: a problem
+  // instantiates them once for its model (`template struct
+  // MechanicalTerms<Model>;` in its .cpp, `extern template` in its header),
+  // and the method units that include the header reuse that instance instead
+  // of compiling the AD evaluations again (docs/build.md).
+
   // Positions only (projection needs no forces): phi, J (rows 0..nh), phi_t.
-  void evaluate_position(const Model& model, double t, const VecQ& q) {
-    if constexpr (has_closed_form()) {
-      if (!use_ad) {
-        model.closed_form_holonomic(t, q, static_cast<const VecQ*>(nullptr), *this);
-        return;
-      }
-    }
-    if constexpr (nh > 0) {
-      using D = ad::Dual<nq + 1>;
-      Vec<D, nq> qd;
-      for (int i = 0; i < nq; ++i) qd(i) = D(q(i), nq + 1, i);
-      const D td(t, nq + 1, nq);
-      Vec<D, nh> f;
-      model.holonomic(td, qd, f);
-      for (int i = 0; i < nh; ++i) {
-        phi(i) = f(i).value();
-        A.row(i) = f(i).derivatives().template head<nq>().transpose();
-        phi_t(i) = f(i).derivatives()(nq);
-      }
-    }
-  }
-
+  void evaluate_position(const Model& model, double t, const VecQ& q);
   // Velocity rows only: A and the velocity residual (affine in v).
-  void evaluate_velocity(const Model& model, double t, const VecQ& q, const VecQ& v) {
-    evaluate_position(model, t, q);
-    if constexpr (nh > 0) velocity.template head<nh>() = A.template topRows<nh>().lazyProduct(v) + phi_t;
-    if constexpr (nn > 0) nonholonomic_terms(model, t, q, v);
-  }
-
-  void evaluate(const Model& model, double t, const VecQ& q, const VecQ& v, bool with_energy) {
-    model.mass(t, q, M);
-    model.forces(t, q, v, Q);
-    if constexpr (nh > 0) {
-      bool closed = false;
-      if constexpr (has_closed_form()) closed = !use_ad;
-      if (closed) {
-        if constexpr (has_closed_form()) model.closed_form_holonomic(t, q, &v, *this);
-        velocity.template head<nh>() = A.template topRows<nh>().lazyProduct(v) + phi_t;
-      } else {
-        holonomic_terms_ad(model, t, q, v);
-      }
-    }
-    if constexpr (nn > 0) nonholonomic_terms(model, t, q, v);
-    if constexpr (Model::kHasEnergy) {
-      if (with_energy) {
-        // Directions: the nq velocities, then the line (t + s, q + s v).
-        LineDuals d(t, q, v);
-        const auto& [td, qd, vd] = d;
-        using D = LineDual;
-        const D e = model.energy(td, qd, vd);
-        energy = e.value();
-        energy_grad_v = e.derivatives().template head<nq>();
-        energy_rate_free = e.derivatives()(nq);
-      }
-    }
-  }
+  void evaluate_velocity(const Model& model, double t, const VecQ& q, const VecQ& v);
+  // Everything: M, Q, the constraint rows, gamma; the energy terms if asked.
+  void evaluate(const Model& model, double t, const VecQ& q, const VecQ& v, bool with_energy);
 
  private:
   // (t, q, v) as duals with nq + 1 directions: the nq velocities, then the
@@ -186,7 +141,75 @@ struct MechanicalTerms {
   };
 
   // phi, J, phi_t, velocity and gamma of the holonomic rows by AD.
-  void holonomic_terms_ad(const Model& model, double t, const VecQ& q, const VecQ& v) {
+  void holonomic_terms_ad(const Model& model, double t, const VecQ& q, const VecQ& v);
+  void nonholonomic_terms(const Model& model, double t, const VecQ& q, const VecQ& v);
+};
+
+template <class Model>
+void MechanicalTerms<Model>::evaluate_position(const Model& model, double t, const VecQ& q) {
+  if constexpr (has_closed_form()) {
+    if (!use_ad) {
+      model.closed_form_holonomic(t, q, static_cast<const VecQ*>(nullptr), *this);
+      return;
+    }
+  }
+  if constexpr (nh > 0) {
+    using D = ad::Dual<nq + 1>;
+    Vec<D, nq> qd;
+    for (int i = 0; i < nq; ++i) qd(i) = D(q(i), nq + 1, i);
+    const D td(t, nq + 1, nq);
+    Vec<D, nh> f;
+    model.holonomic(td, qd, f);
+    for (int i = 0; i < nh; ++i) {
+      phi(i) = f(i).value();
+      A.row(i) = f(i).derivatives().template head<nq>().transpose();
+      phi_t(i) = f(i).derivatives()(nq);
+    }
+  }
+}
+
+template <class Model>
+void MechanicalTerms<Model>::evaluate_velocity(const Model& model, double t, const VecQ& q, const VecQ& v) {
+  evaluate_position(model, t, q);
+  if constexpr (nh > 0) velocity.template head<nh>() = A.template topRows<nh>().lazyProduct(v) + phi_t;
+  if constexpr (nn > 0) nonholonomic_terms(model, t, q, v);
+}
+
+template <class Model>
+void MechanicalTerms<Model>::evaluate(const Model& model, double t, const VecQ& q, const VecQ& v,
+                                      bool with_energy) {
+  model.mass(t, q, M);
+  model.forces(t, q, v, Q);
+  if constexpr (nh > 0) {
+    bool closed = false;
+    if constexpr (has_closed_form()) closed = !use_ad;
+    if (closed) {
+      if constexpr (has_closed_form()) model.closed_form_holonomic(t, q, &v, *this);
+      velocity.template head<nh>() = A.template topRows<nh>().lazyProduct(v) + phi_t;
+    } else {
+      holonomic_terms_ad(model, t, q, v);
+    }
+  }
+  if constexpr (nn > 0) nonholonomic_terms(model, t, q, v);
+  if constexpr (Model::kHasEnergy) {
+    if (with_energy) {
+      // Directions: the nq velocities, then the line (t + s, q + s v).
+      LineDuals d(t, q, v);
+      const auto& [td, qd, vd] = d;
+      using D = LineDual;
+      const D e = model.energy(td, qd, vd);
+      energy = e.value();
+      energy_grad_v = e.derivatives().template head<nq>();
+      energy_rate_free = e.derivatives()(nq);
+    }
+  }
+}
+
+template <class Model>
+void MechanicalTerms<Model>::holonomic_terms_ad(const Model& model, double t, const VecQ& q, const VecQ& v) {
+  // (Guarded: an explicit instantiation compiles every member, and a model
+  // without holonomic rows has no holonomic().)
+  if constexpr (nh > 0) {
     evaluate_position(model, t, q);
     // Second derivative of Phi(t + s, q + s v) at s = 0 (hyper-dual):
     // gamma = d/dt (J v + Phi_t) with v frozen; the first derivative is J v + Phi_t.
@@ -203,8 +226,13 @@ struct MechanicalTerms {
       gamma(i) = f(i).derivatives()(0).derivatives()(0);
     }
   }
+}
 
-  void nonholonomic_terms(const Model& model, double t, const VecQ& q, const VecQ& v) {
+template <class Model>
+void MechanicalTerms<Model>::nonholonomic_terms(const Model& model, double t, const VecQ& q, const VecQ& v) {
+  if constexpr (nn == 0) {
+    return;  // no non-holonomic rows (and no nonholonomic() to call)
+  } else {
     if constexpr (has_closed_form_nonholonomic()) {
       if (!use_ad) {
         model.closed_form_nonholonomic(t, q, v, *this);
@@ -222,7 +250,7 @@ struct MechanicalTerms {
       gamma(nh + i) = psi(i).derivatives()(nq);
     }
   }
-};
+}
 
 // Shared parts of every formulation on y = [q; v].
 template <class Model>

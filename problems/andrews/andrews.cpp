@@ -80,4 +80,7 @@ bool Andrews::reference(double t, double* canonical) const {
   return true;
 }
 
+// The model's AD evaluations, instantiated once (extern in the header).
+template struct MechanicalTerms<AndrewsMechanical>;
+
 }  // namespace cstab

@@ -30,6 +30,7 @@
 #include "core/formulation.hpp"
 #include "core/problem.hpp"
 #include "methods/affine.hpp"
+#include "methods/mechanical.hpp"
 #include "problems/common/trig_rows.hpp"
 
 namespace cstab {
@@ -209,5 +210,8 @@ class Andrews {
   AndrewsParameters params_;
   AndrewsMechanical mechanical_;
 };
+
+// Compiled once, in andrews.cpp; the method units reuse it.
+extern template struct MechanicalTerms<AndrewsMechanical>;
 
 }  // namespace cstab

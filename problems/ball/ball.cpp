@@ -212,4 +212,7 @@ void Ball::first_integrals(double, const double* c, double* out) const {
 
 bool Ball::reference(double t, double* canonical) const { return reference_.at(t, canonical); }
 
+// The model's AD evaluations, instantiated once (extern in the header).
+template struct MechanicalTerms<BallMechanical>;
+
 }  // namespace cstab

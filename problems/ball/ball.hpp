@@ -64,6 +64,7 @@
 #include "core/problem.hpp"
 #include "problems/common/reference_cache.hpp"
 #include "methods/affine.hpp"
+#include "methods/mechanical.hpp"
 
 namespace cstab {
 
@@ -310,5 +311,8 @@ class Ball {
   BallNewtonEuler minimal_;
   ReferenceCache reference_ = reference_cache_of(minimal_, 24);
 };
+
+// Compiled once, in ball.cpp; the method units reuse it.
+extern template struct MechanicalTerms<BallMechanical>;
 
 }  // namespace cstab

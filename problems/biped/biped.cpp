@@ -317,4 +317,7 @@ ProblemInfo Biped::info() const {
   return info;
 }
 
+// The model's AD evaluations, instantiated once (extern in the header).
+template struct MechanicalTerms<BipedMechanical>;
+
 }  // namespace cstab

@@ -121,6 +121,7 @@
 #include "core/formulation.hpp"
 #include "core/problem.hpp"
 #include "methods/affine.hpp"
+#include "methods/mechanical.hpp"
 
 namespace cstab {
 
@@ -345,5 +346,8 @@ class Biped {
   Vec<double, 9> q_proj_, q_flow_;
   Vec<double, 2> x_ref_;
 };
+
+// Compiled once, in biped.cpp; the method units reuse it.
+extern template struct MechanicalTerms<BipedMechanical>;
 
 }  // namespace cstab

@@ -36,4 +36,7 @@ bool CarAxis::reference(double t, double* canonical) const {
   return true;
 }
 
+// The model's AD evaluations, instantiated once (extern in the header).
+template struct MechanicalTerms<CarAxisMechanical>;
+
 }  // namespace cstab

@@ -25,6 +25,7 @@
 #include "core/formulation.hpp"
 #include "core/problem.hpp"
 #include "methods/affine.hpp"
+#include "methods/mechanical.hpp"
 
 namespace cstab {
 
@@ -133,5 +134,8 @@ class CarAxis {
   CarAxisParameters params_;
   CarAxisMechanical mechanical_;
 };
+
+// Compiled once, in car_axis.cpp; the method units reuse it.
+extern template struct MechanicalTerms<CarAxisMechanical>;
 
 }  // namespace cstab

@@ -121,4 +121,7 @@ ProblemInfo SliderCrank::info() const {
 
 bool SliderCrank::reference(double t, double* canonical) const { return reference_.at(t, canonical); }
 
+// The model's AD evaluations, instantiated once (extern in the header).
+template struct MechanicalTerms<SliderCrankMechanical>;
+
 }  // namespace cstab

@@ -39,6 +39,7 @@
 #include "core/problem.hpp"
 #include "problems/common/reference_cache.hpp"
 #include "methods/affine.hpp"
+#include "methods/mechanical.hpp"
 #include "problems/common/trig_rows.hpp"
 
 namespace cstab {
@@ -163,5 +164,8 @@ class SliderCrank {
   SliderCrankMechanical mechanical_;
   ReferenceCache reference_ = reference_cache_of(minimal_, 6);
 };
+
+// Compiled once, in slider_crank.cpp; the method units reuse it.
+extern template struct MechanicalTerms<SliderCrankMechanical>;
 
 }  // namespace cstab

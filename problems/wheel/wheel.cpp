@@ -209,4 +209,7 @@ double Wheel::energy(double, const double* c) const {
 
 bool Wheel::reference(double t, double* canonical) const { return reference_.at(t, canonical); }
 
+// The model's AD evaluations, instantiated once (extern in the header).
+template struct MechanicalTerms<WheelMechanical>;
+
 }  // namespace cstab

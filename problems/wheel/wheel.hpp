@@ -29,6 +29,7 @@
 #include "core/problem.hpp"
 #include "problems/common/reference_cache.hpp"
 #include "methods/affine.hpp"
+#include "methods/mechanical.hpp"
 
 namespace cstab {
 
@@ -388,5 +389,8 @@ class Wheel {
   WheelMechanical mechanical_;
   ReferenceCache reference_ = reference_cache_of(minimal_, 9);
 };
+
+// Compiled once, in wheel.cpp; the method units reuse it.
+extern template struct MechanicalTerms<WheelMechanical>;
 
 }  // namespace cstab
