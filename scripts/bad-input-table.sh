@@ -1,14 +1,22 @@
 #!/usr/bin/env bash
-# The bad-input table of issue 9: every kind of bad input on every command
-# (run, stability, matrix and matrix files, merge, report, list), with what
-# it got: exit code, first line of stderr, number of stderr lines, files left
-# in the output folder. Markdown on stdout. Usage: bash scripts/bad-input-table.sh
-# (uses build/release/cli/cstab, or $CSTAB). Each case: label|arguments,
-# OUT = a fresh output folder, SHARD = a finished one-case results folder.
+# The bad-input table of issues 9 and 16: every kind of bad input on every
+# command (run, stability, matrix and matrix files, merge, report, gate,
+# list), with what it got: exit code, first line of stderr, number of stderr
+# lines, files left in the output folder (for the rows that damage a folder,
+# the files of that folder that changed). Markdown on stdout. Usage: bash
+# scripts/bad-input-table.sh (uses build/release/cli/cstab, or $CSTAB). Each
+# case: label|arguments, OUT = a fresh output folder, SHARD = a finished
+# one-case results folder, and for issue 16: BADID (a shard whose cases.csv
+# names a case ../../escaped), BADCSV (a shard whose cases.csv has index x1),
+# NOCASES (cases.csv and summary.csv but no cases/), THR (thresholds written
+# by --init from SHARD), EMPTYTHR (a header-only thresholds file), PARTTHR
+# (THR without its last row), LOCKED (a copy of SHARD whose lock a
+# background `flock` holds). Every row runs under `timeout 900`.
 set -u
 cd "$(dirname "$0")/.."
 B="${CSTAB:-$(pwd)/build/release/cli/cstab}"
 W=$(mktemp -d /tmp/cstab-bad-input-XXXXXX)
+lock_holder=
 trap 'rm -rf "$W"' EXIT
 G="--problem wheel --method pesterev --integrator rk4 --step 1e-3 --t-end 0.05"
 A="--problem wheel --method pesterev --integrator rk8pd --rtol 1e-6 --atol 1e-6 --t-end 0.05"
@@ -160,12 +168,48 @@ cases+=(
 "report_jobs_zero|report SHARD --jobs 0"
 "report_two|report SHARD SHARD"
 "list_extra|list extra"
+"i16_run_step_1e-320|run --problem slider-crank --method pesterev --integrator rk4 --step 1e-320 --t-end 0.1 --out OUT"
+"i16_run_t_end_1e9_step_1e-9|run --problem slider-crank --method pesterev --integrator rk4 --step 1e-9 --t-end 1e9 --out OUT"
+"i16_run_rk8pd_t_end_1e300|run --problem slider-crank --method pesterev --integrator rk8pd --rtol 1e-6 --atol 1e-6 --t-end 1e300 --no-series --out OUT"
+"i16_run_rk8pd_t_end_1e300_max_steps_1e5|run --problem slider-crank --method pesterev --integrator rk8pd --rtol 1e-6 --atol 1e-6 --t-end 1e300 --max-steps 1e5 --no-series --out OUT"
+"i16_run_max_steps_zero|run $G --max-steps 0 --out OUT"
+"i16_run_param_max_iter_2^31|run ${G/pesterev/projection} --param max_iter=2147483648 --out OUT"
+"i16_run_param_max_iter_fraction|run ${G/pesterev/projection} --param max_iter=2.5 --out OUT"
+"i16_stab_huge_grid|stability ${S/--t-end 0.05/--t-end 1000} --steps 1e-7 --out OUT"
+"i16_matrix_dev_zero|matrix /dev/zero --out OUT"
+"i16_merge_bad_case_id|merge OUT BADID"
+"i16_merge_bad_cases_csv|merge OUT BADCSV"
+"i16_report_bad_cases_csv|report BADCSV"
+"i16_gate_bad_cases_csv|gate --thresholds THR BADCSV"
+"i16_report_no_cases|report NOCASES"
+"i16_gate_update_factor_1e308|gate --update --factor 1e308 --thresholds THR SHARD"
+"i16_gate_init_factor_1e308|gate --init OUT --factor 1e308 SHARD"
+"i16_gate_header_only|gate --thresholds EMPTYTHR SHARD"
+"i16_gate_strict_missing_row|gate --strict --thresholds PARTTHR SHARD"
+"i16_matrix_locked|matrix $M/good.toml --out LOCKED"
+"i16_merge_locked|merge LOCKED SHARD"
+"i16_report_locked|report LOCKED"
+"i16_gate_update_locked|gate --update --thresholds THR LOCKED"
 "list_flag|list --foo"
 "unknown_command|frobnicate"
 )
 # a finished shard for merge/report cases
 rm -rf $W/shard; $B matrix $M/good.toml --out $W/shard --no-report >/dev/null 2>&1
+# the damaged folders of issue 16 (see the head of this file)
+id=$(sed -n 2p $W/shard/cases.csv | cut -d, -f2)
+cp -r $W/shard $W/badid; sed -i "2s|$id|../../escaped|" $W/badid/cases.csv
+cp -r $W/shard $W/badcsv; sed -i '2s|^0,|x1,|' $W/badcsv/cases.csv
+mkdir -p $W/nocases; cp $W/shard/cases.csv $W/shard/summary.csv $W/nocases/
+$B gate --init $W/thr.csv $W/shard >/dev/null 2>&1
+head -n -1 $W/thr.csv > $W/partthr.csv
+printf 'problem,method,integrator,setting\n' > $W/emptythr.csv
+cp -r $W/shard $W/locked
+printf '%s\nflock (bad-input-table.sh)\n' $$ > $W/locked/.cstab.lock
+flock $W/locked/.cstab.lock sleep 3600 & lock_holder=$!
+trap 'kill $lock_holder 2>/dev/null; rm -rf "$W"' EXIT
+sleep 0.2
 shard_before=$(cd $W/shard && find . -type f | sort | xargs md5sum | md5sum)
+snap() { (cd "$1" 2>/dev/null && find . -type f | sort | xargs md5sum 2>/dev/null); }
 printf '| # | input | exit | message (stderr, first line) | lines | files left |\n|---|---|---|---|---|---|\n'
 i=0
 for c in "${cases[@]}"; do
@@ -173,10 +217,26 @@ for c in "${cases[@]}"; do
   label=${c%%|*}; args=${c#*|}
   out=$W/out_$i; rm -rf $out
   args=${args//OUT/$out}; args=${args//SHARD/$W/shard}
-  $B $args >$W/stdout 2>$W/stderr; code=$?
+  args=${args//BADID/$W/badid}; args=${args//BADCSV/$W/badcsv}; args=${args//NOCASES/$W/nocases}
+  args=${args//EMPTYTHR/$W/emptythr.csv}; args=${args//PARTTHR/$W/partthr.csv}; args=${args//THR/$W/thr.csv}
+  args=${args//LOCKED/$W/locked}
+  # the folder a row damages, if any: what changed in it is its "files left"
+  target=""
+  for d in badid badcsv nocases locked; do [[ " $args " == *" $W/$d "* ]] && target=$W/$d; done
+  [[ -z "$target" && " $args " == *" $W/thr.csv "* ]] && target=$W/shard
+  [ -n "$target" ] && before=$(snap $target; md5sum $W/thr.csv)
+  start=$(date +%s.%N)
+  timeout 900 $B $args >$W/stdout 2>$W/stderr; code=$?
+  secs=$(echo "$(date +%s.%N) - $start" | bc)
   msg=$(head -1 $W/stderr | sed "s|$W/||g; s/|/\\\\|/g" | cut -c1-170)
   lines=$(wc -l < $W/stderr)
   if [ -e $out ]; then left=$(find $out -type f | sed "s|$out/||" | tr '\n' ' '); [ -z "$left" ] && left="(empty folder)"; else left="none"; fi
+  if [ -n "$target" ]; then
+    after=$(snap $target; md5sum $W/thr.csv)
+    changed=$(diff <(echo "$before") <(echo "$after") | grep '^[<>]' | awk '{print $3}' | sort -u | tr '\n' ' ')
+    left="$left; $(basename $target): ${changed:-unchanged}"
+  fi
+  [[ $label == i16_* ]] && label="$label ($(printf '%.1f' $secs) s)"
   printf '| %d | %s | %s | %s | %s | %s |\n' "$i" "$label" "$code" "$msg" "$lines" "$left"
 done
 shard_after=$(cd $W/shard && find . -type f | sort | xargs md5sum | md5sum)
