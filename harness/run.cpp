@@ -218,12 +218,14 @@ RunResult run_case(const Problem& problem, const RunConfig& cfg, const std::stri
   // ---- validate everything before any file is created ----
   const IntegratorInfo& integ_info = find_integrator(cfg.integrator);
   check_positive_finite(cfg.t_end, "--t-end");
+  if (!(cfg.max_steps >= 1) || !std::isfinite(cfg.max_steps) || cfg.max_steps > 1e15)
+    throw UsageError("--max-steps: must be a number in [1, 1e15]");
   if (integ_info.fixed_step) {
     check_positive_finite(cfg.step.step, "--step");
     if (cfg.step.step > cfg.t_end) throw UsageError("--step: larger than --t-end");
     const double steps = cfg.t_end / cfg.step.step;
     if (!(steps <= cfg.max_steps))
-      throw UsageError("--step " + format_short(cfg.step.step) + ": t_end / step = " + format_short(steps) +
+      throw UsageError("--step " + format_short(cfg.step.step) + ": t_end / step = " + format_3g(steps) +
                        " steps, more than the limit of " + format_short(cfg.max_steps) +
                        " (--max-steps raises it)");
   } else {
@@ -242,8 +244,6 @@ RunResult run_case(const Problem& problem, const RunConfig& cfg, const std::stri
   if (!std::isfinite(cfg.drift_fit_from) || cfg.drift_fit_from < 0)
     throw UsageError("--drift-fit-from: must be a finite number >= 0 (0: no fit)");
   if (!(cfg.recovery_threshold > 0)) throw UsageError("--recovery-threshold: must be > 0");
-  if (!(cfg.max_steps >= 1) || !std::isfinite(cfg.max_steps) || cfg.max_steps > 1e15)
-    throw UsageError("--max-steps: must be a number in [1, 1e15]");
   const std::string why = problem.why_not(cfg.method);
   if (!why.empty()) throw UsageError("--method " + cfg.method + ": " + why);
   const auto specs = problem.method_params(cfg.method, cfg.formulation);

@@ -1007,7 +1007,7 @@ class Expander {
           continue;
         }
         if (!(t_end / v->number <= p.max_steps))
-          throw MatrixError(v->where, "step: " + v->text + " needs t_end / step = " + format_short(t_end / v->number) +
+          throw MatrixError(v->where, "step: " + v->text + " needs t_end / step = " + format_3g(t_end / v->number) +
                                           " steps (problem '" + info.name + "'), more than max_steps = " +
                                           format_short(p.max_steps) + " (the key max_steps raises it)");
         settings.push_back({v->number, 0, 0});
