@@ -85,7 +85,6 @@ class IdaIntegrator final : public Integrator {
     h_used_ = 0;
     steps_ = rejected_ = rhs_evals_ = 0;
     failure_.clear();
-    failure_t_ = std::numeric_limits<double>::quiet_NaN();
     solver_message_.clear();
     residual_failure_.clear();
     need_initial_condition_ = true;

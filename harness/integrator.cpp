@@ -41,7 +41,6 @@ bool Integrator::eval(double t, const double* y, double* dydt) {
   if (!sys_->rhs(t, y, dydt)) {
     failure_ = sys_->failure_reason();
     if (failure_.empty()) failure_ = "right-hand side failed";
-    failure_t_ = t;
     return false;
   }
   return true;
@@ -62,7 +61,6 @@ class FixedStep : public Integrator {
     t0_ = t0; t_ = t0; grid_index_ = 0;
     steps_ = rejected_ = rhs_evals_ = 0;
     failure_.clear();
-    failure_t_ = std::numeric_limits<double>::quiet_NaN();
     on_start();
   }
 
@@ -213,7 +211,6 @@ class GslAdaptive final : public Integrator {
     t_ = t0;
     steps_ = rejected_ = rhs_evals_ = 0;
     failure_.clear();
-    failure_t_ = std::numeric_limits<double>::quiet_NaN();
     fd_f0_.assign(n_, 0); fd_f1_.assign(n_, 0); fd_y_.assign(n_, 0);
     gsys_ = gsl_odeiv2_system{&GslAdaptive::gsl_rhs, &GslAdaptive::gsl_jac, size_t(n_), this};
     h_ = 1e-6;

@@ -5,8 +5,6 @@
 // not disturb the trajectory. Adaptive schemes land exactly on the limit.
 #pragma once
 
-#include <cmath>
-#include <limits>
 #include <memory>
 #include <string>
 #include <utility>
@@ -58,9 +56,6 @@ class Integrator {
   long rhs_evals() const { return rhs_evals_; }
   double last_step_size() const { return h_used_; }
   const std::string& failure_reason() const { return failure_; }
-  // The time of the evaluation that failed (a stage time may lie beyond
-  // t()); t() if the failure was not in an evaluation.
-  double failure_time() const { return std::isnan(failure_t_) ? t_ : failure_t_; }
   // Solver-specific counters (name, value), appended to the summary row.
   virtual std::vector<std::pair<std::string, std::string>> statistics() const { return {}; }
 
@@ -75,7 +70,6 @@ class Integrator {
   std::vector<double> y_;
   long steps_ = 0, rejected_ = 0, rhs_evals_ = 0;
   std::string failure_;
-  double failure_t_ = std::numeric_limits<double>::quiet_NaN();
 };
 
 std::unique_ptr<Integrator> make_integrator(const std::string& name, const StepSettings& settings);

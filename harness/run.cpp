@@ -342,7 +342,7 @@ RunResult run_case(const Problem& problem, const RunConfig& cfg, const std::stri
       if (outcome == StepOutcome::kFailed) {
         result.status = "failed";
         result.reason = integrator->failure_reason();
-        result.fail_time = integrator->failure_time();
+        result.fail_time = integrator->t();
         alive = false;
         break;
       }
@@ -350,7 +350,7 @@ RunResult run_case(const Problem& problem, const RunConfig& cfg, const std::stri
         if (!integrator->notify_modified()) {
           result.status = "failed";
           result.reason = integrator->failure_reason();
-          result.fail_time = integrator->failure_time();
+          result.fail_time = integrator->t();
           alive = false;
           break;
         }

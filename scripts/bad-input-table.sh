@@ -11,7 +11,9 @@
 # NOCASES (cases.csv and summary.csv but no cases/), THR (thresholds written
 # by --init from SHARD), EMPTYTHR (a header-only thresholds file), PARTTHR
 # (THR without its last row), LOCKED (a copy of SHARD whose lock a
-# background `flock` holds). Every row runs under `timeout 900`.
+# background `flock` holds), READONLY (a copy of SHARD without write
+# permission; its row runs as uid 65534 through setpriv). Every row runs
+# under `timeout 900`.
 set -u
 cd "$(dirname "$0")/.."
 B="${CSTAB:-$(pwd)/build/release/cli/cstab}"
@@ -190,6 +192,7 @@ cases+=(
 "i16_merge_locked|merge LOCKED SHARD"
 "i16_report_locked|report LOCKED"
 "i16_gate_update_locked|gate --update --thresholds THR LOCKED"
+"i16_matrix_read_only_folder_as_uid_65534|NOBODY matrix $M/good.toml --out READONLY"
 "list_flag|list --foo"
 "unknown_command|frobnicate"
 )
@@ -204,9 +207,10 @@ $B gate --init $W/thr.csv $W/shard >/dev/null 2>&1
 head -n -1 $W/thr.csv > $W/partthr.csv
 printf 'problem,method,integrator,setting\n' > $W/emptythr.csv
 cp -r $W/shard $W/locked
+cp -r $W/shard $W/readonly; chmod -R a-w $W/readonly; chmod a+rx $W $M; chmod a+r $M/good.toml
 printf '%s\nflock (bad-input-table.sh)\n' $$ > $W/locked/.cstab.lock
 flock $W/locked/.cstab.lock sleep 3600 & lock_holder=$!
-trap 'kill $lock_holder 2>/dev/null; rm -rf "$W"' EXIT
+trap 'kill $lock_holder 2>/dev/null; chmod -R u+w "$W"; rm -rf "$W"' EXIT
 sleep 0.2
 shard_before=$(cd $W/shard && find . -type f | sort | xargs md5sum | md5sum)
 snap() { (cd "$1" 2>/dev/null && find . -type f | sort | xargs md5sum 2>/dev/null); }
@@ -219,14 +223,15 @@ for c in "${cases[@]}"; do
   args=${args//OUT/$out}; args=${args//SHARD/$W/shard}
   args=${args//BADID/$W/badid}; args=${args//BADCSV/$W/badcsv}; args=${args//NOCASES/$W/nocases}
   args=${args//EMPTYTHR/$W/emptythr.csv}; args=${args//PARTTHR/$W/partthr.csv}; args=${args//THR/$W/thr.csv}
-  args=${args//LOCKED/$W/locked}
+  args=${args//LOCKED/$W/locked}; args=${args//READONLY/$W/readonly}
+  run_as=""; [[ $args == NOBODY\ * ]] && { args=${args#NOBODY }; run_as="setpriv --reuid=65534 --regid=65534 --clear-groups"; }
   # the folder a row damages, if any: what changed in it is its "files left"
   target=""
-  for d in badid badcsv nocases locked; do [[ " $args " == *" $W/$d "* ]] && target=$W/$d; done
+  for d in badid badcsv nocases locked readonly; do [[ " $args " == *" $W/$d "* ]] && target=$W/$d; done
   [[ -z "$target" && " $args " == *" $W/thr.csv "* ]] && target=$W/shard
   [ -n "$target" ] && before=$(snap $target; md5sum $W/thr.csv)
   start=$(date +%s.%N)
-  timeout 900 $B $args >$W/stdout 2>$W/stderr; code=$?
+  timeout 900 $run_as $B $args >$W/stdout 2>$W/stderr; code=$?
   secs=$(echo "$(date +%s.%N) - $start" | bc)
   msg=$(head -1 $W/stderr | sed "s|$W/||g; s/|/\\\\|/g" | cut -c1-170)
   lines=$(wc -l < $W/stderr)
