@@ -98,6 +98,10 @@ void declare_run(Args& a) {
              format_short(d.recovery_threshold))
       .value("--drift-fit-from", "T", "fit the drift growth exponent over [T, t_end] (if t_end >= 4 T; 0: no fit)",
              format_short(d.drift_fit_from))
+      .value("--max-steps", "N",
+             "most steps of the run: a fixed-step run needing more (t_end / step) is refused, an adaptive one "
+             "stops there (status failed)",
+             format_short(d.max_steps))
       .flag("--no-series", "write summary.csv only, no series.csv")
       .required("--out", "DIR", "output folder (created if missing)");
 }
@@ -144,6 +148,7 @@ int cmd_run(const Args& args) {
   cfg.perturb = args.number("--perturb");
   cfg.recovery_threshold = args.number("--recovery-threshold");
   cfg.drift_fit_from = args.number("--drift-fit-from");
+  cfg.max_steps = args.number("--max-steps");
   const std::string out = args.require("--out");
 
   const RunResult r = run_case(problem, cfg, out);

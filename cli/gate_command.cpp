@@ -9,10 +9,12 @@
 #include "cli/gate_command.hpp"
 
 #include <filesystem>
+#include <memory>
 #include <iostream>
 
 #include "cli/args.hpp"
 #include "io/csv.hpp"
+#include "io/lock.hpp"
 #include "core/format.hpp"
 #include "gate/gate.hpp"
 
@@ -32,6 +34,8 @@ void declare_gate(Args& a) {
       .value("--csv", "OUT", "also write the table of checks to OUT (CSV)")
       .flag("--update", "re-baseline the bounds the thresholds file sets from DIR, print what changed")
       .value("--init", "FILE", "write a new thresholds file FILE with every completed case of DIR")
+      .flag("--add-missing", "append a row (by the rule of --init) for every completed case of DIR no row names")
+      .flag("--strict", "also fail (exit 1) when a completed case of DIR has no thresholds row")
       .value("--factor", "F", "--update/--init: upper bounds = measured value x F (>= 1)", format_short(d.value))
       .value("--time-factor", "T", "--update/--init: max_time_ratio = measured ratio x T", format_short(d.time_ratio))
       .value("--recovery-factor", "R", "--update/--init: max_recovery_time = measured time x R",
@@ -65,8 +69,30 @@ int cmd_gate(const Args& args) {
   const std::string path = args.has("--thresholds") ? args.get("--thresholds") : kDefaultThresholds;
   ThresholdsFile file = read_thresholds_file(path);
 
+  // A folder a matrix is still writing is not re-baselined from.
+  std::unique_ptr<FolderLock> lock;
+  if ((args.has("--add-missing") || args.has("--update")) && std::filesystem::is_directory(dir + "/cases"))
+    lock = std::make_unique<FolderLock>(dir, "cstab gate");
+  if (args.has("--add-missing")) {
+    if (args.has("--update") || args.has("--csv") || args.has("--strict"))
+      throw UsageError("--add-missing: writes the thresholds file; not with --update, --csv or --strict");
+    const auto added = add_missing_thresholds(file, dir, factors);
+    for (const auto& label : added) std::cout << "added: " << label << "\n";
+    if (!added.empty()) {
+      try {
+        write_file_atomic(path, thresholds_text(file));
+      } catch (const std::exception& e) {
+        throw UsageError("--thresholds " + path + ": cannot write: " + e.what());
+      }
+    }
+    std::cout << "gate: " << added.size() << " rows added to " << path << " (factor " << format_short(factors.value)
+              << ")\n";
+    return 0;
+  }
+
   if (args.has("--update")) {
     if (args.has("--csv")) throw UsageError("--csv: not with --update");
+    if (args.has("--strict")) throw UsageError("--strict: not with --update");
     std::vector<std::string> notes;
     const auto changes = update_thresholds(file, dir, factors, notes);
     for (const auto& n : notes) std::cout << "note: " << n << "\n";
@@ -87,10 +113,20 @@ int cmd_gate(const Args& args) {
   }
 
   if (args.has("--factor") || args.has("--time-factor") || args.has("--recovery-factor"))
-    throw UsageError("--factor/--time-factor/--recovery-factor: only with --update or --init");
+    throw UsageError("--factor/--time-factor/--recovery-factor: only with --update, --init or --add-missing");
+  if (file.rows.empty())
+    throw UsageError(path + ": no thresholds rows: a gate of 0 checks proves nothing (`cstab gate --init` writes "
+                            "a first file)");
   const GateOutcome outcome = evaluate_gate(file, dir);
   std::cout << format_gate_table(outcome);
-  std::cout << "thresholds " << path << ", results " << dir << ": " << (outcome.failed ? "FAILED" : "passed") << "\n";
+  const bool strict_failed = args.has("--strict") && outcome.unchecked_cases > 0;
+  if (strict_failed) {
+    std::cout << "--strict: " << outcome.unchecked_cases << " completed cases have no thresholds row "
+              << "(`cstab gate --add-missing` adds them):\n";
+    for (const auto& u : outcome.unchecked) std::cout << "  unchecked: " << u << "\n";
+  }
+  const bool failed = outcome.failed > 0 || strict_failed;
+  std::cout << "thresholds " << path << ", results " << dir << ": " << (failed ? "FAILED" : "passed") << "\n";
   if (args.has("--csv")) {
     try {
       write_file_atomic(args.get("--csv"), gate_csv(outcome));
@@ -98,7 +134,7 @@ int cmd_gate(const Args& args) {
       throw UsageError("--csv " + args.get("--csv") + ": " + e.what());
     }
   }
-  return outcome.failed ? 1 : 0;
+  return failed ? 1 : 0;
 }
 
 }  // namespace cstab::cli

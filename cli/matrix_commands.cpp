@@ -3,12 +3,14 @@
 #include <unistd.h>
 
 #include <filesystem>
+#include <memory>
 #include <map>
 #include <iostream>
 #include <thread>
 
 #include "cli/args.hpp"
 #include "io/csv.hpp"
+#include "io/lock.hpp"
 #include "matrix/matrix.hpp"
 #include "matrix/provenance.hpp"
 #include "report/report.hpp"
@@ -172,6 +174,13 @@ int unfinished_exit_code(const MatrixRunStats& stats, const std::string& out) {
               << 128 + stats.interrupted_by << ")\n";
     return 128 + stats.interrupted_by;
   }
+  if (stats.infrastructure) {
+    std::cout.flush();
+    std::cerr << "cstab matrix: " << stats.infrastructure << " of " << stats.total
+              << " cases not recorded (a worker crashed, was killed from outside or hit an I/O error; see above); "
+                 "run the same command again to complete them (exit 1)\n";
+    return 1;
+  }
   if (stats.unfinished) {
     std::cout.flush();
     std::cerr << "cstab matrix: " << stats.unfinished << " of " << stats.total
@@ -228,8 +237,18 @@ int cmd_matrix(const Args& args) {
   const std::string out = args.require("--out");
   const int jobs = jobs_flag(args);
   std::error_code ec;
+  const bool existed = std::filesystem::exists(out);
   std::filesystem::create_directories(out, ec);
   if (ec) throw UsageError("--out " + out + ": cannot create folder: " + ec.message());
+  // The folder is ours until the end (report included); a second command
+  // on it fails now, naming this one.
+  std::unique_ptr<FolderLock> lock;
+  try {
+    lock = std::make_unique<FolderLock>(out, "cstab matrix");
+  } catch (const UsageError&) {
+    if (!existed) std::filesystem::remove(out, ec);  // nothing left behind
+    throw;
+  }
 
   std::cout << "matrix: " << file.name << ": " << expansion.cases.size() << " cases";
   if (!filter.empty()) std::cout << ", " << filtered.size() << " match --filter '" << filter << "'";
@@ -251,6 +270,9 @@ int cmd_matrix(const Args& args) {
   opt.jobs = jobs;
   opt.force = args.has("--force");
   opt.binary_id = binary_identity();
+  if (opt.binary_id == "unknown")
+    std::cout << "matrix: note: the cstab binary cannot be read, so no result is reused or trusted as cached: "
+                 "every case runs\n";
   opt.matrix_text = file.text;
   opt.selected_cases = filtered.size();
   opt.find_problem = [](const std::string& name) -> const Problem& { return find_problem(name); };
@@ -301,7 +323,12 @@ void declare_report(Args& a) {
 int cmd_report(const Args& args) {
   const std::string dir = args.require("DIR");
   const int jobs = jobs_flag(args);
+  // A results folder has its cases; anything else is refused untouched.
+  if (!std::filesystem::is_directory(dir)) throw UsageError(dir + ": no such results folder");
+  if (!std::filesystem::is_directory(dir + "/cases"))
+    throw UsageError(dir + ": not a matrix results folder (no cases/ folder); nothing written");
   const std::vector<CaseEntry> entries = read_results_manifest(dir);
+  const FolderLock lock(dir, "cstab report");
   write_matrix_summary(dir, entries);
   finish(dir, jobs, !args.has("--no-plots"));
   return 0;

@@ -4,6 +4,7 @@
 // stability interval) and, if gnuplot is present, DIR/stability.png/.svg.
 #include "cli/stability_command.hpp"
 
+#include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <iostream>
@@ -27,6 +28,10 @@ void declare_stability(Args& a) {
       .value("--blowup", "B", "residual above which a run counts as unstable", "1")
       .value("--bisect", "N", "bisection steps of the boundary search per step, in [0, 60]",
              std::to_string(d.bisection_iterations))
+      .value("--max-steps", "N",
+             "most integration steps of the whole map and boundary search, estimated up front as "
+             "sum over steps h of t_end / h x (gains + bisect + 2)",
+             "1e9")
       .flag("--no-plot", "do not draw stability.png/.svg (gnuplot)")
       .required("--out", "DIR", "output folder (created if missing)");
 }
@@ -62,6 +67,18 @@ StabilityConfig read_stability(const Args& args, const Problem& problem) {
   // 60 halvings take any bracket below double resolution.
   if (bisect < 0 || bisect > 60) throw UsageError("--bisect: must be in [0, 60]");
   cfg.bisection_iterations = int(bisect);
+  // Every map ends: the work is bounded before anything runs.
+  const double budget = args.number("--max-steps");
+  if (!(budget >= 1 && budget <= 1e15)) throw UsageError("--max-steps: must be a number in [1, 1e15]");
+  if (cfg.steps.size() > 100000 || cfg.gains.size() > 100000)
+    throw UsageError("--steps/--gains: at most 100000 values each");
+  double total = 0;
+  for (double h : cfg.steps) total += std::ceil(cfg.base.t_end / h) * double(cfg.gains.size() + cfg.bisection_iterations + 2);
+  if (!(total <= budget))
+    throw UsageError("--steps/--gains/--bisect: the map needs about " + format_short(total) +
+                     " integration steps, more than the limit of " + format_short(budget) +
+                     " (--max-steps raises it)");
+  cfg.base.max_steps = budget;
   return cfg;
 }
 

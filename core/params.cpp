@@ -1,6 +1,9 @@
 #include "core/params.hpp"
 
 #include <algorithm>
+#include <cctype>
+#include <cerrno>
+#include <cmath>
 #include <cstdlib>
 #include <sstream>
 
@@ -14,11 +17,20 @@ double parse_finite_double(const std::string& text, const std::string& what) {
   char* end = nullptr;
   errno = 0;
   const double value = std::strtod(begin, &end);
-  if (end != begin + text.size())
+  // strtod skips leading blanks; a command-line number has none at either end.
+  if (end != begin + text.size() || std::isspace(static_cast<unsigned char>(text.front())))
     throw UsageError(what + ": '" + text + "' is not a number");
   if (!std::isfinite(value))
     throw UsageError(what + ": '" + text + "' is not a finite number");
   return value;
+}
+
+std::string param_value_problem(const ParamSpec& spec, double value) {
+  if (spec.bound == Bound::kPositive && !(value > 0)) return "must be > 0";
+  if (spec.bound == Bound::kNonNegative && !(value >= 0)) return "must be >= 0";
+  if (spec.integer && value != std::floor(value)) return "must be a whole number";
+  if (!(value <= spec.max_value)) return "must be <= " + format_short(spec.max_value);
+  return "";
 }
 
 Params Params::resolve(const std::vector<ParamSpec>& specs,
@@ -41,10 +53,8 @@ Params Params::resolve(const std::vector<ParamSpec>& specs,
     if (std::find(p.given_.begin(), p.given_.end(), name) != p.given_.end())
       throw UsageError("--param " + name + ": given more than once");
     const double value = parse_finite_double(text, "--param " + name);
-    if (it->bound == Bound::kPositive && !(value > 0))
-      throw UsageError("--param " + name + "=" + text + ": must be > 0");
-    if (it->bound == Bound::kNonNegative && !(value >= 0))
-      throw UsageError("--param " + name + "=" + text + ": must be >= 0");
+    const std::string problem = param_value_problem(*it, value);
+    if (!problem.empty()) throw UsageError("--param " + name + "=" + text + ": " + problem);
     for (auto& [n, v] : p.values_)
       if (n == name) v = value;
     p.given_.push_back(name);

@@ -36,7 +36,14 @@ struct ParamSpec {
   // Parameters that take the same value when this gain is swept (e.g.
   // Baumgarte's beta with alpha: the repeated root -alpha).
   std::vector<std::string> swept_with = {};
+  // A count (an iteration limit): a whole number no larger than max_value,
+  // checked before anything converts it to an int.
+  bool integer = false;
+  double max_value = std::numeric_limits<double>::infinity();
 };
+
+// Why `value` is not allowed for `spec` ("must be > 0", ...); "" if it is.
+std::string param_value_problem(const ParamSpec& spec, double value);
 
 // The method's gain: its first kRate or kTimeScale parameter (nullptr if none).
 const ParamSpec* find_gain(const std::vector<ParamSpec>& specs);

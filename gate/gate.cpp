@@ -456,7 +456,10 @@ GateOutcome evaluate_gate(const ThresholdsFile& file, const std::string& dir) {
     if (!file.rows[i].name.empty()) by_name[file.rows[i].name] = results[i];
   }
   for (const auto& e : entries)
-    if (!named.count(&e) && is_gateable(load_case_result(dir, e).status)) ++out.unchecked_cases;  // n/a ones aside
+    if (!named.count(&e) && is_gateable(load_case_result(dir, e).status)) {  // n/a ones aside
+      ++out.unchecked_cases;
+      out.unchecked.push_back(e.label() + " (" + e.id + ")");
+    }
   for (size_t i = 0; i < file.rows.size(); ++i) {
     const ThresholdRow& row = file.rows[i];
     const CaseResult& r = results[i];
@@ -563,6 +566,18 @@ double derived_bound(const BoundSpec& b, double value, const GateFactors& f) {
   return std::max(value, kValueFloor) * f.value;
 }
 
+// The text of a derived bound; UsageError if it is not a finite number the
+// parser reads back (a factor so large the bound overflows).
+std::string bound_text(const BoundSpec& b, double value, const GateFactors& f, const std::string& label) {
+  const double bound = derived_bound(b, value, f);
+  const std::string text = fmt_bound(bound, b.lower);
+  double back = 0;
+  if (!std::isfinite(bound) || !try_parse_number(text, back) || !std::isfinite(back))
+    throw UsageError(label + ": " + b.column + " = " + fmt(value) + " x factor is not a finite number (" + text +
+                     "); use a smaller --factor/--time-factor/--recovery-factor (nothing written)");
+  return text;
+}
+
 void check_factors(const GateFactors& f) {
   auto check = [](double v, const char* flag) {
     if (!(v >= 1) || !std::isfinite(v)) throw UsageError(std::string(flag) + ": must be a finite number >= 1");
@@ -622,7 +637,7 @@ std::vector<ThresholdChange> update_thresholds(ThresholdsFile& file, const std::
                         " kept (no measured value)");
         continue;
       }
-      const std::string text = fmt_bound(derived_bound(b, value, factors), b.lower);
+      const std::string text = bound_text(b, value, factors, row.label());
       change(b.column, text);
       row.*(b.bound) = parse_number(text);
     }
@@ -630,18 +645,14 @@ std::vector<ThresholdChange> update_thresholds(ThresholdsFile& file, const std::
   return changes;
 }
 
-ThresholdsFile initial_thresholds(const std::string& dir, const GateFactors& factors, const std::string& file_name) {
-  check_factors(factors);
-  const std::vector<CaseEntry> entries = read_results_manifest(dir);
-  ThresholdsFile file;
-  file.name = file_name;
-  file.columns = kColumns;
-  file.lines.push_back("# cstab gate thresholds, written by `cstab gate --init` from " + dir +
-                       " with safety factors " + format_short(factors.value) + " (values), " +
-                       format_short(factors.recovery) + " (recovery times) (docs/gate.md)");
-  std::string header;
-  for (const auto& c : kColumns) header += (header.empty() ? "" : ",") + c;
-  file.lines.push_back(header);
+namespace {
+
+// Rows for the completed, gateable cases of `entries` that `skip` does not
+// hold, by the rule of --init, appended to `file`.
+std::vector<std::string> append_rows(ThresholdsFile& file, const std::string& dir,
+                                     const std::vector<CaseEntry>& entries, const std::set<const CaseEntry*>& skip,
+                                     const GateFactors& factors) {
+  std::vector<std::string> added;
   // Several cases may share a key but for t_end or their sweep; give t_end
   // (and the sweep) only then.
   std::map<std::string, int> key_count, key_t_count;
@@ -653,13 +664,16 @@ ThresholdsFile initial_thresholds(const std::string& dir, const GateFactors& fac
     ++key_count[key_of(e)];
     ++key_t_count[key_t_of(e)];
   }
+  int last_line = int(file.lines.size());
+  for (const auto& r : file.rows) last_line = std::max(last_line, r.line);
   for (const auto& e : entries) {
+    if (skip.count(&e)) continue;
     const CaseResult r = load_case_result(dir, e);
     if (!r.complete || !is_gateable(r.status)) continue;  // n/a (invalid), timeout, crashed: not gated
     ThresholdRow row;
-    row.line = int(file.lines.size()) + 1;
+    row.line = ++last_line;
     file.lines.push_back("");  // placeholder; thresholds_text writes the row here
-    row.fields.assign(kColumns.size(), "");
+    row.fields.assign(file.columns.size(), "");
     row.problem = e.problem;
     row.method = e.method;
     row.formulation = e.formulation;
@@ -686,13 +700,47 @@ ThresholdsFile initial_thresholds(const std::string& dir, const GateFactors& fac
         if (b.bound == &ThresholdRow::max_recovery_time && e.setting.find("perturb=") == std::string::npos)
           continue;  // a consistent start has nothing to recover from
         if (b.lower && value < 1) continue;  // not one correct digit: max_ref_error says it better
-        const std::string text = fmt_bound(derived_bound(b, value, factors), b.lower);
+        if (column_index(file, b.column) < 0) continue;  // a file without that column
+        const std::string text = bound_text(b, value, factors, row.label());
         set_cell(file, row, b.column, text);
         row.*(b.bound) = parse_number(text);
       }
+    added.push_back(row.label());
     file.rows.push_back(std::move(row));
   }
+  return added;
+}
+
+}  // namespace
+
+ThresholdsFile initial_thresholds(const std::string& dir, const GateFactors& factors, const std::string& file_name) {
+  check_factors(factors);
+  const std::vector<CaseEntry> entries = read_results_manifest(dir);
+  ThresholdsFile file;
+  file.name = file_name;
+  file.columns = kColumns;
+  file.lines.push_back("# cstab gate thresholds, written by `cstab gate --init` from " + dir +
+                       " with safety factors " + format_short(factors.value) + " (values), " +
+                       format_short(factors.recovery) + " (recovery times) (docs/gate.md)");
+  std::string header;
+  for (const auto& c : kColumns) header += (header.empty() ? "" : ",") + c;
+  file.lines.push_back(header);
+  append_rows(file, dir, entries, {}, factors);
   return file;
+}
+
+std::vector<std::string> add_missing_thresholds(ThresholdsFile& file, const std::string& dir,
+                                                const GateFactors& factors) {
+  check_factors(factors);
+  for (const char* needed : {"problem", "method", "integrator", "setting"})
+    if (column_index(file, needed) < 0) throw UsageError(file.name + ": no column '" + needed + "'");
+  const std::vector<CaseEntry> entries = read_results_manifest(dir);
+  std::set<const CaseEntry*> named;
+  for (const auto& row : file.rows) {
+    const Match m = find_case(row, entries);
+    if (m.entry) named.insert(m.entry);
+  }
+  return append_rows(file, dir, entries, named, factors);
 }
 
 }  // namespace cstab

@@ -84,6 +84,7 @@ struct GateOutcome {
   std::vector<GateCheck> checks;
   size_t failed = 0;
   size_t unchecked_cases = 0;  // runs of the folder no row names (not a failure; n/a cases aside)
+  std::vector<std::string> unchecked;  // their labels and ids ("label (id)"), for --strict
 };
 
 // Checks results folder `dir` (a `cstab matrix` output) against `file`.
@@ -115,5 +116,11 @@ std::vector<ThresholdChange> update_thresholds(ThresholdsFile& file, const std::
 // bound the case has a value for (recovery time only for perturbed starts),
 // set as update_thresholds would.
 ThresholdsFile initial_thresholds(const std::string& dir, const GateFactors& factors, const std::string& file_name);
+
+// --add-missing: appends to `file` one row per completed, gateable case of
+// `dir` that no row names, built by the rule --init uses. Returns the
+// labels of the rows added.
+std::vector<std::string> add_missing_thresholds(ThresholdsFile& file, const std::string& dir,
+                                                const GateFactors& factors);
 
 }  // namespace cstab

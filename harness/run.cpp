@@ -218,9 +218,16 @@ RunResult run_case(const Problem& problem, const RunConfig& cfg, const std::stri
   // ---- validate everything before any file is created ----
   const IntegratorInfo& integ_info = find_integrator(cfg.integrator);
   check_positive_finite(cfg.t_end, "--t-end");
+  if (!(cfg.max_steps >= 1) || !std::isfinite(cfg.max_steps) || cfg.max_steps > 1e15)
+    throw UsageError("--max-steps: must be a number in [1, 1e15]");
   if (integ_info.fixed_step) {
     check_positive_finite(cfg.step.step, "--step");
     if (cfg.step.step > cfg.t_end) throw UsageError("--step: larger than --t-end");
+    const double steps = cfg.t_end / cfg.step.step;
+    if (!(steps <= cfg.max_steps))
+      throw UsageError("--step " + format_short(cfg.step.step) + ": t_end / step = " + format_3g(steps) +
+                       " steps, more than the limit of " + format_short(cfg.max_steps) +
+                       " (--max-steps raises it)");
   } else {
     check_positive_finite(cfg.step.rtol, "--rtol");
     check_positive_finite(cfg.step.atol, "--atol");
@@ -309,8 +316,10 @@ RunResult run_case(const Problem& problem, const RunConfig& cfg, const std::stri
   targets.push_back(cfg.t_end);
   std::sort(targets.begin(), targets.end());
   targets.erase(std::unique(targets.begin(), targets.end()), targets.end());
+  std::vector<double> output_times = cfg.times;  // sorted: a lookup per target stays O(log n)
+  std::sort(output_times.begin(), output_times.end());
   auto is_output_time = [&](double t) {
-    return t == cfg.t_end || std::find(cfg.times.begin(), cfg.times.end(), t) != cfg.times.end();
+    return t == cfg.t_end || std::binary_search(output_times.begin(), output_times.end(), t);
   };
 
   const auto start = Clock::now();
@@ -320,6 +329,14 @@ RunResult run_case(const Problem& problem, const RunConfig& cfg, const std::stri
   for (double target : targets) {
     if (!alive) break;
     while (alive && integrator->t() < target) {
+      if (double(integrator->steps()) >= cfg.max_steps) {
+        result.status = "failed";
+        result.reason = "step limit: " + format_short(cfg.max_steps) + " steps taken by t = " +
+                        format_short(integrator->t()) + " (--max-steps raises it)";
+        result.fail_time = integrator->t();
+        alive = false;
+        break;
+      }
       const StepOutcome outcome = integrator->step(target);
       if (outcome == StepOutcome::kPastLimit) break;
       if (outcome == StepOutcome::kFailed) {
@@ -383,6 +400,8 @@ RunResult run_case(const Problem& problem, const RunConfig& cfg, const std::stri
     if (series) series->commit();
     summary->write(key_value_csv(result.summary_row()));
     summary->commit();
+    // A series.csv of an earlier run into this folder does not belong to this summary.
+    if (!series) std::remove((out_dir + "/series.csv").c_str());
   }
   return result;
 }

@@ -15,6 +15,11 @@
 
 namespace cstab {
 
+// The default bound on the steps of one run (`--max-steps`, matrix key
+// `max_steps`): 1e8, five times the longest run of the shipped matrices
+// (the Pesterev wheel, h = 1e-5 over 200 s: 2e7 steps).
+inline constexpr double kDefaultMaxSteps = 1e8;
+
 struct RunConfig {
   std::string problem;
   std::string method;
@@ -37,6 +42,10 @@ struct RunConfig {
   // Long horizons: the growth exponent of the running max drift is fitted
   // over t in [drift_fit_from, t_end] (when t_end >= 4 drift_fit_from).
   double drift_fit_from = 10;
+  // Every run ends: a fixed-step run of more than max_steps steps
+  // (t_end / step) is refused before it starts (UsageError); an adaptive run
+  // that takes max_steps steps stops there, recorded as `failed`.
+  double max_steps = kDefaultMaxSteps;
 };
 
 struct ConstraintMetrics {

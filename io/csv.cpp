@@ -48,7 +48,7 @@ AtomicFile::AtomicFile(std::string path) : path_(std::move(path)) {
   file_ = std::fopen(temp_path_.c_str(), "w");
   if (!file_) {
     release_slot(slot_);
-    throw std::runtime_error("cannot write " + path_ + ": " + std::strerror(errno));
+    throw IoError("cannot write " + path_ + ": " + std::strerror(errno));
   }
 }
 
@@ -67,9 +67,9 @@ void AtomicFile::commit() {
   const bool close_error = std::fclose(file_) != 0;
   file_ = nullptr;
   if (write_error || close_error)
-    throw std::runtime_error("error writing " + path_);
+    throw IoError("error writing " + path_);
   if (std::rename(temp_path_.c_str(), path_.c_str()) != 0)
-    throw std::runtime_error("cannot rename into " + path_ + ": " + std::strerror(errno));
+    throw IoError("cannot rename into " + path_ + ": " + std::strerror(errno));
   committed_ = true;
   release_slot(slot_);
   slot_ = -1;

@@ -4,11 +4,18 @@
 #pragma once
 
 #include <cstdio>
+#include <stdexcept>
 #include <string>
 #include <utility>
 #include <vector>
 
 namespace cstab {
+
+// A failure of the machine, not of the input or the simulation: a file
+// that cannot be created, written or renamed (disk full, I/O error).
+struct IoError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
 
 class AtomicFile {
  public:

@@ -31,9 +31,18 @@ std::string SourceLocation::str() const {
 std::string read_text_file(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   if (!in) throw std::runtime_error("cannot read " + path);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
+  // Bounded: a device (/dev/zero) or a runaway file is refused, not read
+  // until memory runs out.
+  std::string text;
+  char buf[1 << 16];
+  while (in.read(buf, sizeof buf) || in.gcount() > 0) {
+    text.append(buf, size_t(in.gcount()));
+    if (text.size() > kMaxInputFileBytes)
+      throw UsageError(path + ": larger than " + std::to_string(kMaxInputFileBytes >> 20) +
+                       " MiB: not a file cstab wrote or reads");
+  }
+  if (in.bad()) throw std::runtime_error("cannot read " + path);
+  return text;
 }
 
 // ===========================================================================
@@ -367,6 +376,8 @@ MatrixFile read_matrix_file(const std::string& path) {
   std::string text;
   try {
     text = read_text_file(path);
+  } catch (const UsageError&) {
+    throw;  // too large
   } catch (const std::exception&) {
     throw UsageError(path + ": cannot read the matrix file");
   }
@@ -384,7 +395,7 @@ const std::vector<std::string>& known_keys() {
   static const std::vector<std::string> keys = {
       "name", "problems", "methods", "formulations", "integrators", "step", "tol", "rtol", "atol",
       "t_end", "ref_time", "times", "sample_every", "blowup", "observe_every", "series", "repeats",
-      "timeout", "repeat_if_under", "work_precision", "overlay", "optional", "perturb"};
+      "timeout", "repeat_if_under", "work_precision", "overlay", "optional", "perturb", "max_steps"};
   return keys;
 }
 
@@ -544,7 +555,10 @@ double estimate_cost(const RunConfig& c, const IntegratorInfo& integ, int repeat
   return evals * repeats;
 }
 
-std::string canonical_text(const RunConfig& c, int repeats, double timeout, double repeat_if_under) {
+// `timeout_text`: "0" for the default timeout (the text every id had
+// before the default existed, so ids stay), "none" for an explicit 0, else
+// the number.
+std::string canonical_text(const RunConfig& c, int repeats, const std::string& timeout_text, double repeat_if_under) {
   std::string params;
   for (const auto& [k, v] : c.params) params += (params.empty() ? "" : ";") + k + "=" + v;
   std::string times;
@@ -559,10 +573,11 @@ std::string canonical_text(const RunConfig& c, int repeats, double timeout, doub
     << "\nt_end=" << format_exact(c.t_end) << "\ntimes=" << times << "\nsample_every=" << format_exact(c.sample_every)
     << "\nref_time=" << format_exact(c.ref_time) << "\nblowup=" << format_exact(c.blowup)
     << "\nobserve_every=" << c.observe_every << "\nseries=" << (c.write_series ? 1 : 0) << "\nrepeats=" << repeats
-    << "\ntimeout=" << format_exact(timeout);
+    << "\ntimeout=" << timeout_text;
   if (repeat_if_under > 0) s << "\nrepeat_if_under=" << format_exact(repeat_if_under);
   // Only when set, so that the ids of unperturbed cases stay what they were.
   if (c.perturb > 0) s << "\nperturb=" << format_exact(c.perturb);
+  if (c.max_steps != kDefaultMaxSteps) s << "\nmax_steps=" << format_exact(c.max_steps);
   s << "\n";
   return s.str();
 }
@@ -596,7 +611,10 @@ struct SweepPlan {
   std::vector<TEnd> t_ends;
   std::vector<const MatrixValue*> formulations, times;
   const MatrixValue* ref_time_value = nullptr;  // for messages
-  double ref_time = -1, sample_every = 0, blowup = 1e3, timeout = 0, repeat_if_under = 0;
+  double ref_time = -1, sample_every = 0, blowup = 1e3, timeout = kDefaultCaseTimeout, repeat_if_under = 0;
+  std::string timeout_text = "0";  // canonical_text's
+  double max_steps = kDefaultMaxSteps;
+  const MatrixValue* max_steps_value = nullptr;  // for messages
   int observe_every = 1, repeats = 1;
   bool series = true, work_precision = true, overlay = false;
   std::vector<double> perturbs;
@@ -805,7 +823,10 @@ class Expander {
     p.blowup = set.number("blowup", 1e3);
     const double observe_every = set.number("observe_every", 1);
     const double repeats = set.number("repeats", 1);
-    p.timeout = set.number("timeout", 0);
+    p.timeout = set.number("timeout", kDefaultCaseTimeout);
+    if (set.find("timeout")) p.timeout_text = p.timeout == 0 ? "none" : format_exact(p.timeout);
+    p.max_steps = set.number("max_steps", kDefaultMaxSteps);
+    if (const MatrixEntry* e = set.find("max_steps")) p.max_steps_value = &e->value;
     p.repeat_if_under = set.number("repeat_if_under", 0);
     auto check = [&](const char* key, bool ok, const std::string& what) {
       if (set.find(key) && !ok) throw MatrixError(set.find(key)->value.where, std::string(key) + ": " + what);
@@ -820,6 +841,7 @@ class Expander {
     check("repeats", repeats >= 1 && repeats <= 1000 && repeats == std::floor(repeats),
           "must be an integer in [1, 1000]");
     check("timeout", p.timeout >= 0, "must be >= 0 seconds (0: none)");
+    check("max_steps", p.max_steps >= 1 && p.max_steps <= 1e15, "must be a number in [1, 1e15]");
     check("repeat_if_under", p.repeat_if_under >= 0, "must be >= 0 seconds (0: always repeat)");
     p.observe_every = int(observe_every);
     p.repeats = int(repeats);
@@ -940,11 +962,9 @@ class Expander {
         continue;
       }
       for (const auto* v : pc.values) {
-        if (spec->bound == Bound::kPositive && !(v->number > 0))
-          throw MatrixError(v->where, "param." + pc.name + " = " + v->text + ": must be > 0 for method '" +
-                                          method.name + "'");
-        if (spec->bound == Bound::kNonNegative && !(v->number >= 0))
-          throw MatrixError(v->where, "param." + pc.name + " = " + v->text + ": must be >= 0 for method '" +
+        const std::string problem = param_value_problem(*spec, v->number);
+        if (!problem.empty())
+          throw MatrixError(v->where, "param." + pc.name + " = " + v->text + ": " + problem + " for method '" +
                                           method.name + "'");
       }
       pc.used = true;
@@ -986,6 +1006,10 @@ class Expander {
           note(p, info.name + ": step " + v->text + " larger than t_end " + format_short(t_end) + ": skipped");
           continue;
         }
+        if (!(t_end / v->number <= p.max_steps))
+          throw MatrixError(v->where, "step: " + v->text + " needs t_end / step = " + format_3g(t_end / v->number) +
+                                          " steps (problem '" + info.name + "'), more than max_steps = " +
+                                          format_short(p.max_steps) + " (the key max_steps raises it)");
         settings.push_back({v->number, 0, 0});
       }
     } else if (!p.tols.empty()) {
@@ -1027,9 +1051,10 @@ class Expander {
     cfg.observe_every = p.observe_every;
     cfg.write_series = p.series;
     cfg.perturb = perturb;
+    cfg.max_steps = p.max_steps;
     c.timeout = p.timeout;
     c.repeat_if_under = p.repeat_if_under;
-    c.config_text = canonical_text(cfg, p.repeats, p.timeout, p.repeat_if_under);
+    c.config_text = canonical_text(cfg, p.repeats, p.timeout_text, p.repeat_if_under);
     CaseEntry& e = c.entry;
     e.id = hash_hex(c.config_text);
     if (!seen_ids_.insert(e.id).second) {
@@ -1144,13 +1169,38 @@ const std::string& CsvTable::get(size_t row, const std::string& name) const {
 }
 
 CsvTable read_csv(const std::string& path) {
-  const std::string text = read_text_file(path);
+  std::string text = read_text_file(path);
+  if (text.rfind("\xEF\xBB\xBF", 0) == 0) text.erase(0, 3);  // a UTF-8 byte order mark: allowed, skipped
   std::vector<std::vector<std::string>> records;
   std::vector<std::string> record;
+  std::vector<int> record_lines;                 // the line each record starts on
+  std::vector<std::vector<int>> record_columns;  // the column each of its cells starts at
+  std::vector<int> columns;
   std::string field;
-  bool quoted = false, field_started = false;
+  bool quoted = false, field_started = false, at_field_start = true;
+  int line = 1, record_line = 1, quote_line = 0, quote_column = 0;
+  size_t line_start = 0;
+  auto end_record = [&] {
+    record.push_back(std::move(field));
+    records.push_back(std::move(record));
+    record_columns.push_back(std::move(columns));
+    record_lines.push_back(record_line);
+    field.clear();
+    record.clear();
+    columns.clear();
+  };
   for (size_t i = 0; i < text.size(); ++i) {
     const char c = text[i];
+    const int column = int(i - line_start) + 1;
+    if (at_field_start && !quoted) {
+      if (record.empty()) record_line = line;
+      columns.push_back(column);
+      at_field_start = false;
+    }
+    if (c == '\n') {
+      ++line;
+      line_start = i + 1;
+    }
     if (quoted) {
       if (c == '"') {
         if (i + 1 < text.size() && text[i + 1] == '"') {
@@ -1166,34 +1216,51 @@ CsvTable read_csv(const std::string& path) {
     }
     if (c == '"' && field.empty()) {
       quoted = true;
+      quote_line = line;
+      quote_column = column;
       field_started = true;
     } else if (c == ',') {
       record.push_back(std::move(field));
       field.clear();
       field_started = true;
+      at_field_start = true;
     } else if (c == '\n') {
-      if (field_started || !field.empty() || !record.empty()) {
-        record.push_back(std::move(field));
-        records.push_back(std::move(record));
-      }
+      if (field_started || !field.empty() || !record.empty())
+        end_record();
+      else
+        columns.clear();  // a blank line
       field.clear();
-      record.clear();
       field_started = false;
+      at_field_start = true;
     } else if (c != '\r') {
       field += c;
       field_started = true;
     }
   }
-  if (field_started || !field.empty() || !record.empty()) {
-    record.push_back(std::move(field));
-    records.push_back(std::move(record));
-  }
-  if (quoted) throw std::runtime_error(path + ": unterminated quoted field");
+  if (quoted)
+    throw UsageError(path + ":" + std::to_string(quote_line) + ":" + std::to_string(quote_column) +
+                     ": unterminated quoted field");
+  if (field_started || !field.empty() || !record.empty()) end_record();
   CsvTable t;
+  t.path = path;
   if (records.empty()) return t;
   t.header = std::move(records.front());
   t.rows.assign(std::make_move_iterator(records.begin() + 1), std::make_move_iterator(records.end()));
+  t.row_lines.assign(record_lines.begin() + 1, record_lines.end());
+  t.row_columns.assign(std::make_move_iterator(record_columns.begin() + 1),
+                       std::make_move_iterator(record_columns.end()));
   return t;
+}
+
+std::string CsvTable::where(size_t row, const std::string& name) const {
+  std::string s = path;
+  if (row < row_lines.size()) {
+    s += ":" + std::to_string(row_lines[row]);
+    const int c = column(name);
+    if (c >= 0 && row < row_columns.size() && size_t(c) < row_columns[row].size())
+      s += ":" + std::to_string(row_columns[row][c]);
+  }
+  return s;
 }
 
 }  // namespace cstab

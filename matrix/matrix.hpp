@@ -113,10 +113,15 @@ struct CaseEntry {
   std::string label() const;   // one line for progress output
 };
 
+// The timeout of a case whose matrix gives none (key `timeout`): 600 s, far
+// above the longest case of the default matrix; `timeout = 0` given
+// explicitly means none.
+inline constexpr double kDefaultCaseTimeout = 600;
+
 struct MatrixCase {
   CaseEntry entry;
   RunConfig config;
-  double timeout = 0;        // seconds, 0: none
+  double timeout = kDefaultCaseTimeout;  // seconds, 0: none
   double repeat_if_under = 0;  // repeat only while a run takes less (seconds); 0: always
   std::string config_text;   // canonical configuration; id = hash(config_text)
   double cost_estimate = 0;  // relative, for scheduling and shard balance
@@ -164,6 +169,9 @@ struct MatrixRunStats {
   size_t not_applicable = 0;  // rejected by the harness before running (status "invalid")
   size_t unfinished = 0;      // not run or killed unfinished (interrupted): rerun next time
   int interrupted_by = 0;     // SIGINT, SIGTERM or SIGHUP that stopped the matrix; 0: ran to the end
+  // Workers that crashed, were killed from outside (not by their timeout)
+  // or hit an I/O error: not recorded, not cached; the matrix exits 1.
+  size_t infrastructure = 0;
   double seconds = 0;
 };
 
@@ -210,12 +218,21 @@ size_t merge_results(const std::string& out_dir, const std::vector<std::string>&
 // Small CSV reader (RFC 4180 quoting) for the files this suite writes.
 
 struct CsvTable {
+  std::string path;
   std::vector<std::string> header;
   std::vector<std::vector<std::string>> rows;
+  std::vector<int> row_lines;                 // 1-based line each row starts on
+  std::vector<std::vector<int>> row_columns;  // 1-based column each cell starts at
   int column(const std::string& name) const;  // -1 if absent
   const std::string& get(size_t row, const std::string& name) const;  // "" if absent
+  // "path:line:column" of a cell (for messages).
+  std::string where(size_t row, const std::string& name) const;
 };
-CsvTable read_csv(const std::string& path);  // throws std::runtime_error
-std::string read_text_file(const std::string& path);  // throws std::runtime_error
+// Throws std::runtime_error if unreadable, UsageError (path:line:column) for
+// an unterminated quote or a file over kMaxInputFileBytes.
+CsvTable read_csv(const std::string& path);
+std::string read_text_file(const std::string& path);  // as read_csv
+// The largest file cstab reads (matrix files, thresholds, results CSVs).
+inline constexpr size_t kMaxInputFileBytes = size_t(512) << 20;
 
 }  // namespace cstab

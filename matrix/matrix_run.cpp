@@ -1,6 +1,7 @@
 // Running a matrix: a pool of forked workers, the per-case cache, progress,
 // the manifest and summary of a results folder, and merging shard folders.
 #include <signal.h>
+#include <sys/prctl.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -14,12 +15,15 @@
 #include <filesystem>
 #include <iostream>
 #include <map>
+#include <memory>
 #include <set>
 #include <sstream>
 #include <thread>
 
 #include "core/format.hpp"
 #include "io/csv.hpp"
+#include "io/hash.hpp"
+#include "io/lock.hpp"
 #include "io/number.hpp"
 #include "matrix/matrix.hpp"
 #include "matrix/provenance.hpp"
@@ -35,7 +39,8 @@ using Row = std::vector<std::pair<std::string, std::string>>;
 using Clock = std::chrono::steady_clock;
 
 // Child exit codes.
-constexpr int kExitOk = 0, kExitDiverged = 10, kExitFailed = 11, kExitInvalid = 12;
+constexpr int kExitOk = 0, kExitDiverged = 10, kExitFailed = 11, kExitInvalid = 12, kExitOrphan = 13,
+              kExitInfrastructure = 14;
 
 std::string case_folder(const std::string& out, const std::string& id) { return out + "/cases/" + id; }
 
@@ -72,9 +77,68 @@ Row failure_row(const MatrixCase& c, Status status, const std::string& reason) {
   return row;
 }
 
+// The files of a case folder whose content key.txt records.
+constexpr const char* kResultFiles[] = {"summary.csv", "series.csv"};
+
+// "file NAME SIZE HASH" lines for the result files present in `dir`: a
+// 64-bit FNV-1a of the content (io/hash.hpp). It guards against accidents
+// (a truncated, edited, swapped or half-copied file), not against an
+// attacker, who could forge a matching file.
+std::string content_lines(const std::string& dir) {
+  std::string out;
+  for (const char* name : kResultFiles) {
+    const std::string path = dir + "/" + name;
+    if (!fs::exists(path)) continue;
+    const std::string bytes = read_text_file(path);
+    out += std::string("file ") + name + " " + std::to_string(bytes.size()) + " " + hash_hex(bytes) + "\n";
+  }
+  return out;
+}
+
 void write_result(const std::string& dir, const std::vector<Row>& rows, const std::string& key) {
   write_file_atomic(dir + "/summary.csv", rows_to_csv(rows));
-  write_file_atomic(dir + "/key.txt", key);  // last: marks the result complete
+  // last: marks the result complete, with what it is made of
+  write_file_atomic(dir + "/key.txt", key + content_lines(dir));
+}
+
+// Why the cached result in `dir` cannot be reused for `key` ("" if it can):
+// key.txt must hold this configuration and binary, then list every result
+// file with the size and hash it has now.
+std::string cache_problem(const std::string& dir, const std::string& key) {
+  std::string text;
+  try {
+    text = read_text_file(dir + "/key.txt");
+  } catch (const std::exception&) {
+    return fs::exists(dir) ? "no key.txt (unfinished)" : "not run yet";
+  }
+  if (text.compare(0, key.size(), key) != 0) return "configuration or binary changed";
+  std::istringstream lines(text.substr(key.size()));
+  std::string line;
+  std::set<std::string> listed;
+  while (std::getline(lines, line)) {
+    std::istringstream words(line);
+    std::string tag, name, hash;
+    unsigned long long size = 0;
+    if (!(words >> tag >> name >> size >> hash) || tag != "file") return "key.txt: malformed line '" + line + "'";
+    listed.insert(name);
+    const std::string path = dir + "/" + name;
+    std::error_code ec;
+    const auto actual = fs::file_size(path, ec);
+    if (ec) return name + " missing";
+    if (actual != size)
+      return name + " has " + std::to_string(actual) + " bytes, " + std::to_string(size) + " recorded (truncated or edited)";
+    std::string bytes;
+    try {
+      bytes = read_text_file(path);
+    } catch (const std::exception&) {
+      return name + " unreadable";
+    }
+    if (hash_hex(bytes) != hash) return name + " content differs from the recorded hash (edited or swapped)";
+  }
+  if (!listed.count("summary.csv")) return "key.txt records no content hashes (written by an older cstab)";
+  for (const char* name : kResultFiles)
+    if (!listed.count(name) && fs::exists(dir + "/" + name)) return std::string(name) + " not recorded in key.txt";
+  return "";
 }
 
 // In the forked worker: every repeat of one case. Returns the exit code.
@@ -91,6 +155,8 @@ int run_in_worker(const MatrixCase& c, const Problem& problem, const std::string
       rows = {failure_row(c, Status::kInvalid, e.what())};
       code = kExitInvalid;
       break;
+    } catch (const IoError&) {
+      throw;  // the machine's failure, not the case's: never recorded as a result
     } catch (const std::exception& e) {
       rows = {failure_row(c, Status::kFailed, std::string("exception: ") + e.what())};
       code = kExitFailed;
@@ -213,9 +279,15 @@ std::vector<const MatrixCase*> uncached_cases(const std::vector<MatrixCase>& cas
   std::vector<const MatrixCase*> todo;
   for (const auto& c : cases) {
     const std::string dir = case_folder(opt.out_dir, c.entry.id);
-    if (!opt.force && file_equals(dir + "/key.txt", cache_key(c, opt.binary_id))) {
-      ++stats.cached;
-      continue;
+    if (!opt.force && !opt.binary_id.empty() && opt.binary_id != "unknown") {
+      const std::string why = cache_problem(dir, cache_key(c, opt.binary_id));
+      if (why.empty()) {
+        ++stats.cached;
+        continue;
+      }
+      // A result that was there but cannot be trusted: say why it runs again.
+      if (why != "not run yet" && why != "configuration or binary changed")
+        log << "matrix: rerun " << c.entry.label() << "  (" << c.entry.id << "): " << why << "\n";
     }
     todo.push_back(&c);
   }
@@ -341,14 +413,27 @@ void WorkerPool::start_worker(const MatrixCase& c) {
   log_.flush();
   std::fflush(nullptr);
   StopSignals::block(true);
+  const pid_t parent = ::getpid();
   const pid_t pid = ::fork();
   if (pid == 0) {
+    // A worker dies with its parent (a matrix killed with -9 leaves no
+    // orphan computing on); if the parent died before prctl, exit now.
+    ::prctl(PR_SET_PDEATHSIG, SIGKILL);
+    if (::getppid() != parent) ::_exit(kExitOrphan);
     StopSignals::defaults_in_child();
+    // The worker's own bound, should the parent be too busy to kill it:
+    // SIGALRM a few seconds after the case's timeout.
+    if (c.timeout > 0) ::alarm(unsigned(std::min(c.timeout + 5.0, 1e9)));
     int code = kExitFailed;
     try {
       code = run_in_worker(c, problem, dir, key);
+    } catch (const std::exception& e) {
+      // An I/O error (disk full, ...) or an unexpected exception: the
+      // parent reports it and records nothing.
+      std::fprintf(stderr, "cstab matrix: worker for case %s: %s\n", c.entry.id.c_str(), e.what());
+      code = kExitInfrastructure;
     } catch (...) {
-      code = 99;
+      code = kExitInfrastructure;
     }
     std::fflush(nullptr);
     ::_exit(code);
@@ -403,17 +488,49 @@ void WorkerPool::unfinished(const MatrixCase& c, const std::string& why) {
 
 // A finished worker: its result recorded (written here for crashes and timeouts), counted, printed.
 void WorkerPool::record(const MatrixCase& c, int wait_status, double seconds, bool timed_out) {
+  // The worker's own alarm (matrix_run: start_worker) is its timeout.
+  if (WIFSIGNALED(wait_status) && WTERMSIG(wait_status) == SIGALRM && c.timeout > 0) timed_out = true;
   if (!timed_out && WIFSIGNALED(wait_status) && is_stop_signal(WTERMSIG(wait_status))) {
     unfinished(c, std::string("worker stopped by ") + signal_name(WTERMSIG(wait_status)));
     return;
   }
   const std::string dir = case_folder(opt_.out_dir, c.entry.id);
   auto [outcome, reason] = worker_outcome(c, wait_status, timed_out);
-  if (outcome == Status::kCrashed || outcome == Status::kTimeout) {
+  // Only simulation outcomes are cached (ok, diverged, failed, invalid,
+  // timeout). A worker that crashed, was killed from outside or hit an I/O
+  // error says nothing about the case: reported, not recorded, and the
+  // matrix exits non-zero.
+  if (outcome == Status::kCrashed) {
+    std::error_code ec;
+    fs::remove_all(dir, ec);
+    ++stats_.infrastructure;
+    ++finished_;
+    if (tty_) log_ << "\r\033[K";
+    log_ << "[" << (stats_.cached + finished_) << "/" << stats_.total << "] NOT RECORDED " << c.entry.label() << "  ("
+         << c.entry.id << ")\n    "
+         << (WIFEXITED(wait_status) && WEXITSTATUS(wait_status) == kExitInfrastructure
+                 ? std::string("infrastructure failure in the worker (message above)")
+                 : reason)
+         << ": not cached, runs again next time\n" << std::flush;
+    return;
+  }
+  if (outcome == Status::kTimeout) {
     try {
+      // Nothing the killed worker left half-written (its *.tmp.<pid> files,
+      // a series.csv of an earlier repeat) stays beside the recorded outcome.
+      std::error_code ec;
+      fs::remove_all(dir, ec);
+      fs::create_directories(dir, ec);
       write_result(dir, {failure_row(c, outcome, reason)}, cache_key(c, opt_.binary_id));
     } catch (const std::exception& e) {
-      reason += "; cannot record: " + std::string(e.what());
+      std::error_code ec;
+      fs::remove_all(dir, ec);
+      ++stats_.infrastructure;
+      ++finished_;
+      log_ << "[" << (stats_.cached + finished_) << "/" << stats_.total << "] NOT RECORDED " << c.entry.label()
+           << "  (" << c.entry.id << ")\n    cannot record its " << status_name(outcome) << ": " << e.what() << "\n"
+           << std::flush;
+      return;
     }
   }
   const bool failure = outcome != Status::kOk && outcome != Status::kDiverged && outcome != Status::kInvalid;
@@ -534,6 +651,8 @@ std::vector<CaseEntry> read_results_manifest(const std::string& dir) {
   std::vector<CaseEntry> entries;
   try {
     entries = read_manifest(dir + "/cases.csv");
+  } catch (const UsageError&) {
+    throw;  // a malformed manifest: its message names file:line:column
   } catch (const std::runtime_error& e) {
     throw UsageError(dir + ": not a matrix results folder (" + e.what() + ")");
   }
@@ -552,14 +671,17 @@ std::vector<CaseEntry> read_manifest(const std::string& path, size_t* selected_c
     auto number = [&](const char* col, bool whole) {
       double v = 0;
       const std::string& text = t.get(i, col);
-      if (!try_parse_number(text, v) || !std::isfinite(v) || (whole && (v < 0 || v != std::floor(v))))
-        throw UsageError(path + ": row " + std::to_string(i + 2) + ": " + col + ": '" + text + "' is not " +
+      if (!try_parse_number(text, v) || !std::isfinite(v) || (whole && (v < 0 || v != std::floor(v) || v > 1e15)))
+        throw UsageError(t.where(i, col) + ": " + col + ": '" + text + "' is not " +
                          (whole ? "a count" : "a number"));
       return v;
     };
     CaseEntry e;
     e.index = size_t(number("index", true));
     e.id = t.get(i, "case_id");
+    // An id names a folder: 16 hex digits and nothing else (no path).
+    if (e.id.size() != 16 || e.id.find_first_not_of("0123456789abcdef") != std::string::npos)
+      throw UsageError(t.where(i, "case_id") + ": case_id: '" + e.id + "' is not a case id (16 hex digits)");
     e.sweep = t.get(i, "sweep");
     e.problem = t.get(i, "problem");
     e.method = t.get(i, "method");
@@ -633,6 +755,8 @@ void read_shard(Shards& shards, const std::string& out_dir, const std::vector<st
   std::vector<CaseEntry> entries;
   try {
     entries = read_manifest(dir + "/cases.csv", &n);
+  } catch (const UsageError&) {
+    throw;
   } catch (const std::runtime_error& e) {
     throw UsageError(dir + ": " + e.what());
   }
@@ -683,8 +807,18 @@ size_t merge_results(const std::string& out_dir, const std::vector<std::string>&
   for (size_t s = 0; s < shard_dirs.size(); ++s) read_shard(shards, out_dir, shard_dirs, s);
   if (shards.binaries.size() > 1)
     log << "merge: warning: the shards were run by " << shards.binaries.size() << " different binaries\n";
-  // Copy the complete cases.
+  // Copy the complete cases, with OUT locked.
   std::error_code ec;
+  const bool existed = fs::exists(out_dir);
+  fs::create_directories(out_dir, ec);
+  if (ec) throw UsageError("cannot create " + out_dir + ": " + ec.message());
+  std::unique_ptr<FolderLock> lock;
+  try {
+    lock = std::make_unique<FolderLock>(out_dir, "cstab merge");
+  } catch (const UsageError&) {
+    if (!existed) fs::remove(out_dir, ec);
+    throw;
+  }
   fs::create_directories(out_dir + "/cases", ec);
   if (ec) throw UsageError("cannot create " + out_dir + ": " + ec.message());
   std::vector<CaseEntry> entries;

@@ -125,7 +125,8 @@ struct ProjectionMethod : MechanicalMethod<ProjectionMethod> {
       "index-1 ODE + post-step projection of positions (mass-weighted Gauss-Newton) then velocities";
   static std::vector<ParamSpec> generic_params() {
     return {{"tol", 1e-13, Bound::kPositive, "stop the position iteration when max |Phi| <= tol"},
-            {"max_iter", 5, Bound::kPositive, "Gauss-Newton iterations per step at most"}};
+            {"max_iter", 5, Bound::kPositive, "Gauss-Newton iterations per step at most (a whole number <= 1e6)",
+             ParamRole::kSetting, {}, /*integer=*/true, /*max_value=*/1e6}};
   }
   template <class Model>
   static std::unique_ptr<Formulation> make_model(const Model& model, const Params& params) {

@@ -1,14 +1,26 @@
 #!/usr/bin/env bash
-# The bad-input table of issue 9: every kind of bad input on every command
-# (run, stability, matrix and matrix files, merge, report, list), with what
-# it got: exit code, first line of stderr, number of stderr lines, files left
-# in the output folder. Markdown on stdout. Usage: bash scripts/bad-input-table.sh
-# (uses build/release/cli/cstab, or $CSTAB). Each case: label|arguments,
-# OUT = a fresh output folder, SHARD = a finished one-case results folder.
+# The bad-input table of issues 9 and 16: every kind of bad input on every
+# command (run, stability, matrix and matrix files, merge, report, gate,
+# list), with what it got: exit code, first line of stderr, number of stderr
+# lines, files left in the output folder (for the rows that damage a folder,
+# the files of that folder that changed). Markdown on stdout. Usage: bash
+# scripts/bad-input-table.sh (uses build/release/cli/cstab, or $CSTAB). Each
+# case: label|arguments, OUT = a fresh output folder, SHARD = a finished
+# one-case results folder, and for issue 16: BADID (a shard whose cases.csv
+# names a case ../../escaped), BADCSV (a shard whose cases.csv has index x1),
+# NOCASES (cases.csv and summary.csv but no cases/), THR (thresholds written
+# by --init from DIV, a two-case folder whose step 3e-3 case diverges),
+# DIVTHR (a row bounding that diverged case's residual), EMPTYTHR (a header-only thresholds file), PARTTHR
+# (THR without its last row), LOCKED (a copy of SHARD whose lock a
+# background `flock` holds), READONLY (a copy of SHARD without write
+# permission; its row runs as uid 65534 through setpriv). Every row runs
+# under `timeout 900`; SKIP_SLOW=1 skips the row that takes minutes (an
+# adaptive run up to the default step limit of 1e8).
 set -u
 cd "$(dirname "$0")/.."
 B="${CSTAB:-$(pwd)/build/release/cli/cstab}"
 W=$(mktemp -d /tmp/cstab-bad-input-XXXXXX)
+lock_holder=
 trap 'rm -rf "$W"' EXIT
 G="--problem wheel --method pesterev --integrator rk4 --step 1e-3 --t-end 0.05"
 A="--problem wheel --method pesterev --integrator rk8pd --rtol 1e-6 --atol 1e-6 --t-end 0.05"
@@ -160,23 +172,85 @@ cases+=(
 "report_jobs_zero|report SHARD --jobs 0"
 "report_two|report SHARD SHARD"
 "list_extra|list extra"
+"i16_run_step_1e-320|run --problem slider-crank --method pesterev --integrator rk4 --step 1e-320 --t-end 0.1 --out OUT"
+"i16_run_t_end_1e9_step_1e-9|run --problem slider-crank --method pesterev --integrator rk4 --step 1e-9 --t-end 1e9 --out OUT"
+"i16_slow_run_rk8pd_t_end_1e300|run --problem slider-crank --method pesterev --integrator rk8pd --rtol 1e-6 --atol 1e-6 --t-end 1e300 --no-series --out OUT"
+"i16_run_rk8pd_t_end_1e300_max_steps_1e5|run --problem slider-crank --method pesterev --integrator rk8pd --rtol 1e-6 --atol 1e-6 --t-end 1e300 --max-steps 1e5 --no-series --out OUT"
+"i16_run_max_steps_zero|run $G --max-steps 0 --out OUT"
+"i16_run_param_max_iter_2^31|run ${G/pesterev/projection} --param max_iter=2147483648 --out OUT"
+"i16_run_param_max_iter_fraction|run ${G/pesterev/projection} --param max_iter=2.5 --out OUT"
+"i16_stab_huge_grid|stability --problem wheel --method pesterev --integrator rk4 --gain-param lambda --steps 1e-7 --gains 10 --t-end 100 --no-plot --out OUT"
+"i16_matrix_dev_zero|matrix /dev/zero --out OUT"
+"i16_merge_bad_case_id|merge OUT BADID"
+"i16_merge_bad_cases_csv|merge OUT BADCSV"
+"i16_report_bad_cases_csv|report BADCSV"
+"i16_gate_bad_cases_csv|gate --thresholds THR BADCSV"
+"i16_report_no_cases|report NOCASES"
+"i16_gate_update_factor_1e308|gate --update --factor 1e308 --thresholds DIVTHR DIV"
+"i16_gate_header_only|gate --thresholds EMPTYTHR DIV"
+"i16_gate_strict_missing_row|gate --strict --thresholds PARTTHR DIV"
+"i16_matrix_locked|matrix $M/good.toml --out LOCKED"
+"i16_merge_locked|merge LOCKED SHARD"
+"i16_report_locked|report LOCKED"
+"i16_gate_update_locked|gate --update --thresholds THR LOCKED"
+"i16_matrix_read_only_folder_as_uid_65534|NOBODY matrix $M/good.toml --out READONLY"
 "list_flag|list --foo"
 "unknown_command|frobnicate"
 )
 # a finished shard for merge/report cases
 rm -rf $W/shard; $B matrix $M/good.toml --out $W/shard --no-report >/dev/null 2>&1
+# the damaged folders of issue 16 (see the head of this file)
+id=$(sed -n 2p $W/shard/cases.csv | cut -d, -f2)
+cp -r $W/shard $W/badid; sed -i "2s|$id|../../escaped|" $W/badid/cases.csv
+cp -r $W/shard $W/badcsv; sed -i '2s|^0,|x1,|' $W/badcsv/cases.csv
+mkdir -p $W/nocases; cp $W/shard/cases.csv $W/shard/summary.csv $W/nocases/
+printf '[[sweep]]\nproblems = ["wheel"]\nmethods = ["pesterev"]\nintegrators = "rk4"\nstep = [3e-3, 1e-3]\nt_end = 1\n' > $M/div.toml
+$B matrix $M/div.toml --out $W/div --no-report >/dev/null 2>&1   # step 3e-3 diverges (residual ~1e3)
+$B gate --init $W/thr.csv $W/div >/dev/null 2>&1
+head -n -1 $W/thr.csv > $W/partthr.csv
+printf 'problem,method,integrator,setting,status,max_residual\nwheel,pesterev,rk4,step=0.003,diverged,1\n' > $W/divthr.csv
+printf 'problem,method,integrator,setting\n' > $W/emptythr.csv
+cp -r $W/shard $W/locked
+cp -r $W/shard $W/readonly; chmod -R a-w $W/readonly; chmod a+rx $W $M; chmod a+r $M/good.toml
+printf '%s\nflock (bad-input-table.sh)\n' $$ > $W/locked/.cstab.lock
+flock $W/locked/.cstab.lock sleep 3600 & lock_holder=$!
+trap 'kill $lock_holder 2>/dev/null; chmod -R u+w "$W"; rm -rf "$W"' EXIT
+sleep 0.2
 shard_before=$(cd $W/shard && find . -type f | sort | xargs md5sum | md5sum)
+snap() { (cd "$1" 2>/dev/null && find . -type f | sort | xargs md5sum 2>/dev/null); }
 printf '| # | input | exit | message (stderr, first line) | lines | files left |\n|---|---|---|---|---|---|\n'
 i=0
 for c in "${cases[@]}"; do
   i=$((i+1))
   label=${c%%|*}; args=${c#*|}
+  # SKIP_SLOW=1: leave out the rows that take minutes (the default step limit of an adaptive run)
+  if [[ ${SKIP_SLOW:-0} == 1 && $label == *_slow_* ]]; then printf '| %d | %s | skipped (SKIP_SLOW=1) | | | |\n' "$i" "$label"; continue; fi
   out=$W/out_$i; rm -rf $out
   args=${args//OUT/$out}; args=${args//SHARD/$W/shard}
-  $B $args >$W/stdout 2>$W/stderr; code=$?
+  args=${args//BADID/$W/badid}; args=${args//BADCSV/$W/badcsv}; args=${args//NOCASES/$W/nocases}
+  args=${args//EMPTYTHR/$W/emptythr.csv}; args=${args//PARTTHR/$W/partthr.csv}; args=${args//DIVTHR/$W/divthr.csv}
+  args=${args//THR/$W/thr.csv}; args=${args//DIV/$W/div}
+  args=${args//LOCKED/$W/locked}; args=${args//READONLY/$W/readonly}
+  run_as=""; [[ $args == NOBODY\ * ]] && { args=${args#NOBODY }; run_as="setpriv --reuid=65534 --regid=65534 --clear-groups"; }
+  # the folder a row damages, if any: what changed in it is its "files left"
+  target=""
+  for d in badid badcsv nocases locked readonly; do [[ " $args " == *" $W/$d "* ]] && target=$W/$d; done
+  [[ " $args " == *" $W/divthr.csv "* ]] && target=$W/div
+  [ -n "$target" ] && before=$(snap $target; md5sum $W/thr.csv $W/divthr.csv)
+  start=$(date +%s.%N)
+  timeout 900 $run_as $B $args >$W/stdout 2>$W/stderr; code=$?
+  secs=$(echo "$(date +%s.%N) - $start" | bc)
+  # a failed check (exit 1) reports on stdout: its last line then
+  [ ! -s $W/stderr ] && [ $code != 0 ] && tail -1 $W/stdout > $W/stderr
   msg=$(head -1 $W/stderr | sed "s|$W/||g; s/|/\\\\|/g" | cut -c1-170)
   lines=$(wc -l < $W/stderr)
   if [ -e $out ]; then left=$(find $out -type f | sed "s|$out/||" | tr '\n' ' '); [ -z "$left" ] && left="(empty folder)"; else left="none"; fi
+  if [ -n "$target" ]; then
+    after=$(snap $target; md5sum $W/thr.csv $W/divthr.csv)
+    changed=$(diff <(echo "$before") <(echo "$after") | grep '^[<>]' | awk '{print $3}' | sort -u | tr '\n' ' ')
+    left="$left; $(basename $target): ${changed:-unchanged}"
+  fi
+  [[ $label == i16_* ]] && label="$label ($(printf '%.1f' $secs) s)"
   printf '| %d | %s | %s | %s | %s | %s |\n' "$i" "$label" "$code" "$msg" "$lines" "$left"
 done
 shard_after=$(cd $W/shard && find . -type f | sort | xargs md5sum | md5sum)

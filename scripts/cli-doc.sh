@@ -21,6 +21,10 @@ trap 'rm -f "$tmp"' EXIT
   echo "when cases are missing. Numbers must be finite (no NaN, inf or trailing text). \`--t-end\`"
   echo "takes a number, \`ref\` (the problem's reference time; its default horizon if it has none) or"
   echo "\`default\` (the problem's default horizon), as \`t_end\` does in matrix files (docs/matrix.md)."
+  echo "Every run ends: a fixed-step run of more than \`--max-steps\` steps (default 1e8) is refused before it"
+  echo "starts, an adaptive one stops there (status \`failed\`); \`stability\` bounds the steps of a whole map."
+  echo "\`matrix\`, \`merge\`, \`report\` and \`gate --update\` lock the results folder (\`DIR/.cstab.lock\`): a second"
+  echo "one on the same folder exits 2 at once, naming the holder's pid."
   echo
   echo '```'
   "$B" --help

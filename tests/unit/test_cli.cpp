@@ -513,14 +513,16 @@ const std::map<std::string, std::set<std::string>> kCommandOptions = {
     {"run",
      {"--problem", "--method", "--formulation", "--param", "--integrator", "--step", "--rtol", "--atol", "--t-end",
       "--times", "--sample-every", "--ref-time", "--blowup", "--observe-every", "--perturb", "--recovery-threshold",
-      "--drift-fit-from", "--no-series", "--out"}},
+      "--drift-fit-from", "--max-steps", "--no-series", "--out"}},
     {"stability",
      {"--problem", "--method", "--formulation", "--param", "--integrator", "--gain-param", "--steps", "--gains",
-      "--t-end", "--blowup", "--bisect", "--no-plot", "--out"}},
+      "--t-end", "--blowup", "--bisect", "--max-steps", "--no-plot", "--out"}},
     {"matrix", {"--out", "--jobs", "--shard", "--filter", "--force", "--no-report", "--list", "--print-default"}},
     {"merge", {"--jobs", "--no-report"}},
     {"report", {"--jobs", "--no-plots"}},
-    {"gate", {"--thresholds", "--csv", "--update", "--init", "--factor", "--time-factor", "--recovery-factor"}},
+    {"gate",
+     {"--thresholds", "--csv", "--update", "--init", "--add-missing", "--strict", "--factor", "--time-factor",
+      "--recovery-factor"}},
 };
 
 // One option line of a --help: "  --step H      fixed step, for euler, rk4".

@@ -1,0 +1,412 @@
+// Results you can trust (issue 16): every run ends (step-count guard, step
+// limit, default case timeout, bounded stability maps); bad input is
+// refused with exit 2 and leaves nothing behind (integer parameters, case
+// ids, report on a non-results folder, gate bounds that would overflow,
+// malformed cases.csv with file:line:column, --strict / --add-missing); a
+// results folder is locked while a command writes it; a cached case is
+// re-verified against the content hashes in its key.txt and rerun, saying
+// why, when a file is missing, truncated, edited or swapped.
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "io/lock.hpp"
+#include "matrix/matrix.hpp"
+#include "methods/pair.hpp"
+#include "problems/registry.hpp"
+#include "tests/support/test_util.hpp"
+
+namespace fs = std::filesystem;
+using cstab::testing::quote;
+using cstab::testing::Scratch;
+using cstab::testing::slurp;
+
+namespace {
+
+struct Outcome {
+  int code = -1;
+  std::string out;  // stdout and stderr
+};
+
+Outcome cstab_cmd(const std::string& args) {
+  const std::string cmd = quote(CSTAB_BINARY) + " " + args + " 2>&1";
+  Outcome o;
+  std::FILE* p = ::popen(cmd.c_str(), "r");
+  char buf[4096];
+  size_t n;
+  while ((n = std::fread(buf, 1, sizeof buf, p)) > 0) o.out.append(buf, n);
+  const int status = ::pclose(p);
+  o.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return o;
+}
+
+bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
+
+// Every file below `dir` with its content, for "nothing changed" checks.
+std::string snapshot(const fs::path& dir) {
+  std::string s;
+  std::error_code ec;
+  if (!fs::exists(dir, ec)) return "(none)";
+  std::vector<std::string> names;
+  for (const auto& e : fs::recursive_directory_iterator(dir, ec))
+    if (e.is_regular_file()) names.push_back(e.path().string());
+  std::sort(names.begin(), names.end());
+  for (const auto& n : names) s += n + "\n" + slurp(n) + "\n";
+  return s;
+}
+
+const char* kRun = "run --problem wheel --method pesterev --integrator rk4 --t-end 0.05 ";
+
+cstab::MatrixCatalog catalog() {
+  cstab::MatrixCatalog c;
+  for (const auto& p : cstab::all_problems()) c.problems.push_back(p.get());
+  c.methods = cstab::all_methods();
+  return c;
+}
+
+// ------------------------------------------------------------- every run ends
+
+TEST(EveryRunEnds, TooManyFixedStepsAreRefusedUpFront) {
+  Scratch s;
+  const std::string out = (s.dir() / "o").string();
+  for (const char* bad : {"run --problem slider-crank --method pesterev --integrator rk4 --step 1e-320 --t-end 0.1",
+                          "run --problem wheel --method pesterev --integrator rk4 --step 1e-9 --t-end 1e9"}) {
+    const auto start = std::chrono::steady_clock::now();
+    const Outcome o = cstab_cmd(std::string(bad) + " --out " + quote(out));
+    EXPECT_EQ(o.code, 2) << o.out;
+    EXPECT_TRUE(contains(o.out, "more than the limit of 1e+08 (--max-steps raises it)")) << o.out;
+    EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), 10);
+    EXPECT_FALSE(fs::exists(out));
+  }
+  // The flag moves the limit both ways: 50 steps refused under 10, run under 100.
+  Outcome o = cstab_cmd(std::string(kRun) + "--step 1e-3 --max-steps 10 --out " + quote(out));
+  EXPECT_EQ(o.code, 2) << o.out;
+  EXPECT_TRUE(contains(o.out, "50 steps, more than the limit of 10")) << o.out;
+  o = cstab_cmd(std::string(kRun) + "--step 1e-3 --max-steps 100 --out " + quote(out));
+  EXPECT_EQ(o.code, 0) << o.out;
+  o = cstab_cmd(std::string(kRun) + "--step 1e-3 --max-steps 0 --out " + quote(s.dir() / "p"));
+  EXPECT_EQ(o.code, 2) << o.out;
+  EXPECT_TRUE(contains(o.out, "--max-steps: must be a number in [1, 1e15]")) << o.out;
+}
+
+TEST(EveryRunEnds, AnAdaptiveRunStopsAtItsStepLimitAsARecordedFailure) {
+  Scratch s;
+  const std::string out = (s.dir() / "o").string();
+  const Outcome o = cstab_cmd(
+      "run --problem wheel --method pesterev --integrator rk8pd --rtol 1e-8 --atol 1e-8 --t-end 1e300 "
+      "--max-steps 2000 --no-series --out " + quote(out));
+  ASSERT_EQ(o.code, 0) << o.out;
+  const cstab::CsvTable t = cstab::read_csv(out + "/summary.csv");
+  ASSERT_EQ(t.rows.size(), 1u);
+  EXPECT_EQ(t.get(0, "status"), "failed");
+  EXPECT_TRUE(contains(t.get(0, "reason"), "step limit: 2000 steps taken by t = ")) << t.get(0, "reason");
+  EXPECT_EQ(t.get(0, "steps"), "2000");
+  EXPECT_FALSE(t.get(0, "fail_time").empty());
+}
+
+TEST(EveryRunEnds, StabilityMapsAreBoundedUpFront) {
+  Scratch s;
+  const std::string out = (s.dir() / "o").string();
+  const std::string map =
+      "stability --problem wheel --method pesterev --integrator rk4 --gain-param lambda --gains 10,100 --no-plot ";
+  Outcome o = cstab_cmd(map + "--steps 1e-7 --t-end 100 --out " + quote(out));
+  EXPECT_EQ(o.code, 2) << o.out;
+  EXPECT_TRUE(contains(o.out, "integration steps, more than the limit of 1e+09 (--max-steps raises it)")) << o.out;
+  EXPECT_FALSE(fs::exists(out));
+  o = cstab_cmd(map + "--steps 1e-3 --t-end 1 --bisect 2 --max-steps 1000 --out " + quote(out));
+  EXPECT_EQ(o.code, 2) << o.out;  // 1000 steps x (2 gains + 2 bisections + 2 brackets)
+  EXPECT_TRUE(contains(o.out, "about 6000 integration steps")) << o.out;
+}
+
+TEST(EveryRunEnds, MatrixCasesHaveADefaultTimeoutAndAStepLimitKey) {
+  const std::string head = "[[sweep]]\nproblems = [\"wheel\"]\nmethods = [\"pesterev\"]\nintegrators = \"rk4\"\n"
+                           "t_end = 1\n";
+  const auto plain = cstab::expand_matrix(cstab::parse_matrix(head + "step = 1e-3\n", "m.toml"), catalog());
+  ASSERT_EQ(plain.cases.size(), 1u);
+  EXPECT_EQ(plain.cases[0].timeout, cstab::kDefaultCaseTimeout);
+  EXPECT_EQ(plain.cases[0].timeout, 600);
+  // The default keeps the ids cases had before it existed ("timeout=0").
+  EXPECT_TRUE(contains(plain.cases[0].config_text, "\ntimeout=0\n"));
+  EXPECT_EQ(plain.cases[0].entry.id, cstab::hash_hex(plain.cases[0].config_text));
+  const auto none = cstab::expand_matrix(cstab::parse_matrix(head + "step = 1e-3\ntimeout = 0\n", "m.toml"), catalog());
+  EXPECT_EQ(none.cases[0].timeout, 0);
+  EXPECT_NE(none.cases[0].entry.id, plain.cases[0].entry.id);
+  try {
+    cstab::expand_matrix(cstab::parse_matrix(head + "step = [1e-3, 1e-9]\n", "m.toml"), catalog());
+    ADD_FAILURE() << "1e9 steps accepted";
+  } catch (const cstab::UsageError& e) {
+    EXPECT_TRUE(contains(e.what(), "m.toml:6:15: step: 1e-9 needs t_end / step = 1e+09 steps")) << e.what();
+  }
+  const auto raised =
+      cstab::expand_matrix(cstab::parse_matrix(head + "step = 1e-9\nmax_steps = 2e9\n", "m.toml"), catalog());
+  EXPECT_EQ(raised.cases[0].config.max_steps, 2e9);
+  EXPECT_TRUE(contains(raised.cases[0].config_text, "max_steps=2000000000"));
+}
+
+TEST(EveryRunEnds, ATimedOutCaseIsRecordedWithoutTemporaryFiles) {
+  Scratch s;
+  std::ofstream(s.dir() / "m.toml") << "[[sweep]]\nproblems = [\"wheel\"]\nmethods = [\"pesterev\"]\n"
+                                       "integrators = \"rk4\"\nstep = 1e-6\nt_end = 50\nref_time = 0\ntimeout = 1\n";
+  const fs::path out = s.dir() / "out";
+  const Outcome o = cstab_cmd("matrix " + quote(s.dir() / "m.toml") + " --out " + quote(out) + " --jobs 1 --no-report");
+  EXPECT_EQ(o.code, 0) << o.out;
+  const cstab::CsvTable t = cstab::read_csv((out / "summary.csv").string());
+  ASSERT_EQ(t.rows.size(), 1u);
+  EXPECT_EQ(t.get(0, "status"), "timeout");
+  for (const auto& e : fs::recursive_directory_iterator(out))
+    EXPECT_FALSE(contains(e.path().filename().string(), ".tmp.")) << e.path();
+  // A timeout is a simulation outcome: cached.
+  const Outcome again =
+      cstab_cmd("matrix " + quote(s.dir() / "m.toml") + " --out " + quote(out) + " --jobs 1 --no-report");
+  EXPECT_TRUE(contains(again.out, "1 of 1 cases cached")) << again.out;
+}
+
+// ------------------------------------------------------------- bad input
+
+TEST(BadInput, IntegerParametersAreRangeCheckedBeforeConversion) {
+  Scratch s;
+  const std::string run = "run --problem wheel --method projection --integrator rk4 --step 1e-3 --t-end 0.05 ";
+  for (const char* v : {"2147483648", "1e300", "2.5"}) {
+    const Outcome o = cstab_cmd(run + "--param max_iter=" + v + " --out " + quote(s.dir() / "o"));
+    EXPECT_EQ(o.code, 2) << v << ": " << o.out;
+    EXPECT_TRUE(contains(o.out, std::string("--param max_iter=") + v + ": must be")) << o.out;
+    EXPECT_FALSE(fs::exists(s.dir() / "o"));
+  }
+  const std::string head = "[[sweep]]\nproblems = [\"wheel\"]\nmethods = [\"projection\"]\nintegrators = \"rk4\"\n"
+                           "step = 1e-3\nt_end = 1\nparam.max_iter = 2147483648\n";
+  try {
+    cstab::expand_matrix(cstab::parse_matrix(head, "m.toml"), catalog());
+    ADD_FAILURE() << "max_iter = 2^31 accepted";
+  } catch (const cstab::UsageError& e) {
+    EXPECT_TRUE(contains(e.what(), "m.toml:7:18: param.max_iter = 2147483648: must be <= 1e+06")) << e.what();
+  }
+  EXPECT_EQ(cstab_cmd(run + "--param max_iter=7 --out " + quote(s.dir() / "ok")).code, 0);
+}
+
+TEST(BadInput, CommandLineNumbersTakeNoBlanksAtEitherEnd) {
+  Scratch s;
+  for (const char* step : {" 1e-3", "1e-3 "}) {
+    const Outcome o = cstab_cmd(std::string(kRun) + "--step '" + step + "' --out " + quote(s.dir() / "o"));
+    EXPECT_EQ(o.code, 2) << "'" << step << "': " << o.out;
+    EXPECT_TRUE(contains(o.out, "is not a number")) << o.out;
+  }
+}
+
+TEST(BadInput, NoSeriesIntoAnOldFolderLeavesNoStaleSeries) {
+  Scratch s;
+  const std::string out = quote(s.dir() / "o");
+  ASSERT_EQ(cstab_cmd(std::string(kRun) + "--step 1e-3 --out " + out).code, 0);
+  ASSERT_TRUE(fs::exists(s.dir() / "o" / "series.csv"));
+  ASSERT_EQ(cstab_cmd(std::string(kRun) + "--step 1e-3 --no-series --out " + out).code, 0);
+  EXPECT_FALSE(fs::exists(s.dir() / "o" / "series.csv"));
+}
+
+TEST(BadInput, ADeviceAsInputIsRefusedNotReadForever) {
+  const Outcome o = cstab_cmd("matrix /dev/zero --list");
+  EXPECT_EQ(o.code, 2) << o.out;
+  EXPECT_TRUE(contains(o.out, "larger than 512 MiB")) << o.out;
+}
+
+// A finished one-case results folder, shared (read-only) by the tests below.
+class Folder : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    dir_ = new Scratch("cstab_trust");
+    std::ofstream(dir_->dir() / "m.toml")
+        << "[[sweep]]\nproblems = [\"wheel\"]\nmethods = [\"pesterev\", \"baumgarte\"]\nintegrators = \"rk4\"\n"
+           "step = [1e-2, 3e-3]\nt_end = 1\n";
+    const Outcome o = cstab_cmd("matrix " + quote(dir_->dir() / "m.toml") + " --out " + quote(shard()) +
+                                " --jobs 2 --no-report");
+    ASSERT_EQ(o.code, 0) << o.out;
+  }
+  static void TearDownTestSuite() {
+    delete dir_;
+    dir_ = nullptr;
+  }
+  static fs::path shard() { return dir_->dir() / "shard"; }
+  // A copy of the shard to damage.
+  static fs::path copy(const std::string& name) {
+    const fs::path to = dir_->dir() / name;
+    fs::remove_all(to);
+    fs::copy(shard(), to, fs::copy_options::recursive);
+    return to;
+  }
+  static std::string matrix_into(const fs::path& out) {
+    return "matrix " + quote(dir_->dir() / "m.toml") + " --out " + quote(out) + " --jobs 2 --no-report";
+  }
+  static std::vector<std::string> ids() {
+    std::vector<std::string> v;
+    const auto t = cstab::read_csv((shard() / "cases.csv").string());
+    for (size_t i = 0; i < t.rows.size(); ++i) v.push_back(t.get(i, "case_id"));
+    return v;
+  }
+  static Scratch* dir_;
+};
+Scratch* Folder::dir_ = nullptr;
+
+TEST_F(Folder, MergeRefusesCaseIdsThatAreNotSixteenHexDigits) {
+  const fs::path bad = copy("bad_ids");
+  std::string manifest = slurp(bad / "cases.csv");
+  const std::string id = ids()[0];
+  manifest.replace(manifest.find(id), id.size(), "../../escaped");
+  std::ofstream(bad / "cases.csv") << manifest;
+  const fs::path out = dir_->dir() / "merged";
+  const Outcome o = cstab_cmd("merge " + quote(out) + " " + quote(bad));
+  EXPECT_EQ(o.code, 2) << o.out;
+  EXPECT_TRUE(contains(o.out, "cases.csv:2:3: case_id: '../../escaped' is not a case id (16 hex digits)")) << o.out;
+  EXPECT_FALSE(fs::exists(out));
+  EXPECT_FALSE(fs::exists(dir_->dir() / "escaped"));
+}
+
+TEST_F(Folder, MalformedCasesCsvGivesFileLineColumnFromGateReportAndMerge) {
+  const fs::path bad = copy("bad_manifest");
+  std::string manifest = slurp(bad / "cases.csv");
+  const size_t line2 = manifest.find('\n') + 1;
+  manifest.replace(line2, manifest.find(',', line2) - line2, "x1");  // index = x1
+  std::ofstream(bad / "cases.csv") << manifest;
+  const std::string before = snapshot(bad);
+  for (const std::string& cmd : {"gate --thresholds " + quote(CSTAB_SOURCE_DIR "/matrices/gate-thresholds.csv") +
+                                     " " + quote(bad),
+                                 "report --no-plots " + quote(bad),
+                                 "merge " + quote(dir_->dir() / "m2") + " " + quote(bad)}) {
+    const Outcome o = cstab_cmd(cmd);
+    EXPECT_EQ(o.code, 2) << cmd << "\n" << o.out;
+    EXPECT_TRUE(contains(o.out, (bad / "cases.csv").string() + ":2:1: index: 'x1' is not a count")) << o.out;
+  }
+  EXPECT_EQ(snapshot(bad), before);
+  EXPECT_FALSE(fs::exists(dir_->dir() / "m2"));
+}
+
+TEST_F(Folder, ReportRefusesAFolderWithoutCasesAndTouchesNothing) {
+  const fs::path bad = dir_->dir() / "no_cases";
+  fs::create_directories(bad);
+  fs::copy_file(shard() / "cases.csv", bad / "cases.csv");
+  fs::copy_file(shard() / "summary.csv", bad / "summary.csv");
+  const std::string before = snapshot(bad);
+  const Outcome o = cstab_cmd("report --no-plots " + quote(bad));
+  EXPECT_EQ(o.code, 2) << o.out;
+  EXPECT_TRUE(contains(o.out, "not a matrix results folder (no cases/ folder)")) << o.out;
+  EXPECT_EQ(snapshot(bad), before);
+}
+
+TEST_F(Folder, GateUpdateNeverWritesABoundTheParserRejects) {
+  const fs::path dir = copy("gate_inf");
+  // A diverged case's residual (above the blow-up level 1e3) times 1e308 overflows.
+  const std::string text = "problem,method,integrator,setting,status,max_residual\n"
+                           "wheel,pesterev,rk4,step=0.003,diverged,1\n";
+  std::ofstream(dir / "t.csv") << text;
+  const Outcome o = cstab_cmd("gate --update --factor 1e308 --thresholds " + quote(dir / "t.csv") + " " + quote(dir));
+  EXPECT_EQ(o.code, 2) << o.out;
+  EXPECT_TRUE(contains(o.out, "max_residual = ")) << o.out;
+  EXPECT_TRUE(contains(o.out, "x factor is not a finite number (inf)")) << o.out;
+  EXPECT_EQ(slurp(dir / "t.csv"), text);
+  // A factor that keeps the bound finite is written, and the parser reads it back.
+  EXPECT_EQ(cstab_cmd("gate --update --factor 1e300 --thresholds " + quote(dir / "t.csv") + " " + quote(dir)).code, 0);
+  EXPECT_NE(slurp(dir / "t.csv"), text);
+  EXPECT_EQ(cstab_cmd("gate --thresholds " + quote(dir / "t.csv") + " " + quote(dir)).code, 0);
+}
+
+TEST_F(Folder, GateStrictFailsOnUncheckedCasesAndAddMissingAddsThem) {
+  const fs::path dir = copy("gate_strict");
+  ASSERT_EQ(cstab_cmd("gate --init " + quote(dir / "t.csv") + " " + quote(dir)).code, 0);
+  // Drop the last row: one case is unchecked.
+  std::string text = slurp(dir / "t.csv");
+  text.erase(text.rfind('\n', text.size() - 2) + 1);
+  std::ofstream(dir / "t.csv") << text;
+  const std::string gate = "gate --thresholds " + quote(dir / "t.csv") + " ";
+  EXPECT_EQ(cstab_cmd(gate + quote(dir)).code, 0);
+  Outcome o = cstab_cmd(gate + "--strict " + quote(dir));
+  EXPECT_EQ(o.code, 1) << o.out;
+  EXPECT_TRUE(contains(o.out, "--strict: 1 completed cases have no thresholds row")) << o.out;
+  o = cstab_cmd(gate + "--add-missing " + quote(dir));
+  EXPECT_EQ(o.code, 0) << o.out;
+  EXPECT_TRUE(contains(o.out, "gate: 1 rows added")) << o.out;
+  EXPECT_EQ(cstab_cmd(gate + "--strict " + quote(dir)).code, 0);
+  o = cstab_cmd(gate + "--add-missing " + quote(dir));
+  EXPECT_TRUE(contains(o.out, "gate: 0 rows added")) << o.out;
+  // A header-only file checks nothing: an error.
+  std::ofstream(dir / "empty.csv") << "problem,method,integrator,setting\n";
+  o = cstab_cmd("gate --thresholds " + quote(dir / "empty.csv") + " " + quote(dir));
+  EXPECT_EQ(o.code, 2) << o.out;
+  EXPECT_TRUE(contains(o.out, "no thresholds rows")) << o.out;
+}
+
+// ------------------------------------------------------------- the lock
+
+TEST_F(Folder, AFolderInUseIsRefusedNamingItsHolderAndAStaleLockIsTakenOver) {
+  const fs::path dir = copy("locked");
+  {
+    const cstab::FolderLock held(dir.string(), "the test");
+    const std::string before = snapshot(dir);
+    const std::string holder = "in use by another cstab command (pid " + std::to_string(::getpid()) + " the test)";
+    for (const std::string& cmd :
+         {matrix_into(dir), "report --no-plots " + quote(dir), "merge " + quote(dir) + " " + quote(shard()),
+          "gate --update --thresholds " + quote(dir / "t.csv") + " " + quote(dir)}) {
+      if (cmd.rfind("gate", 0) == 0) std::ofstream(dir / "t.csv") << "problem,method,integrator,setting\nwheel,pesterev,rk4,step=0.01\n";
+      const std::string snap = snapshot(dir);
+      const Outcome o = cstab_cmd(cmd);
+      EXPECT_EQ(o.code, 2) << cmd << "\n" << o.out;
+      EXPECT_TRUE(contains(o.out, holder)) << cmd << "\n" << o.out;
+      EXPECT_EQ(snapshot(dir), snap) << cmd;
+    }
+    (void)before;
+  }
+  // The holder is gone (its lock file remains, naming a dead pid): taken over.
+  std::ofstream(dir / cstab::FolderLock::file_name()) << "999999999\ncstab matrix\n";
+  const Outcome o = cstab_cmd(matrix_into(dir));
+  EXPECT_EQ(o.code, 0) << o.out;
+  EXPECT_EQ(std::stol(slurp(dir / cstab::FolderLock::file_name())) > 0, true);
+}
+
+// ------------------------------------------------------------- the cache verifies
+
+TEST_F(Folder, ACachedCaseWhoseFilesChangedIsRerunSayingWhy) {
+  const fs::path dir = copy("verify");
+  const auto id = ids();
+  ASSERT_EQ(id.size(), 4u);
+  const std::string full = cstab::testing::summary_without_timing(shard() / "summary.csv");
+  // Untouched: all cached.
+  Outcome o = cstab_cmd(matrix_into(dir));
+  ASSERT_EQ(o.code, 0) << o.out;
+  EXPECT_TRUE(contains(o.out, "4 of 4 cases cached")) << o.out;
+  // Truncated series, edited summary, deleted series, swapped summaries.
+  const fs::path c0 = dir / "cases" / id[0], c1 = dir / "cases" / id[1], c2 = dir / "cases" / id[2],
+                 c3 = dir / "cases" / id[3];
+  fs::resize_file(c0 / "series.csv", fs::file_size(c0 / "series.csv") / 2);
+  std::string summary = slurp(c1 / "summary.csv");
+  summary[summary.size() - 2] = summary[summary.size() - 2] == '1' ? '2' : '1';
+  std::ofstream(c1 / "summary.csv", std::ios::binary) << summary;
+  fs::remove(c2 / "series.csv");
+  fs::rename(c3 / "summary.csv", dir / "tmp.csv");
+  fs::copy_file(c2 / "summary.csv", c3 / "summary.csv");
+  o = cstab_cmd(matrix_into(dir));
+  ASSERT_EQ(o.code, 0) << o.out;
+  EXPECT_TRUE(contains(o.out, "rerun ")) << o.out;
+  EXPECT_TRUE(contains(o.out, "(" + id[0] + "): series.csv has ")) << o.out;
+  EXPECT_TRUE(contains(o.out, "(" + id[1] + "): summary.csv content differs from the recorded hash")) << o.out;
+  EXPECT_TRUE(contains(o.out, "(" + id[2] + "): series.csv missing")) << o.out;
+  EXPECT_TRUE(contains(o.out, "(" + id[3] + "): summary.csv")) << o.out;
+  EXPECT_TRUE(contains(o.out, "4 run, 0 cached")) << o.out;
+  EXPECT_EQ(cstab::testing::summary_without_timing(dir / "summary.csv"), full);
+  // And now all of it verifies again.
+  o = cstab_cmd(matrix_into(dir));
+  EXPECT_TRUE(contains(o.out, "4 of 4 cases cached")) << o.out;
+}
+
+TEST_F(Folder, KeyFilesRecordTheContentOfTheResult) {
+  const std::string key = slurp(shard() / "cases" / ids()[0] / "key.txt");
+  EXPECT_TRUE(contains(key, "\nfile summary.csv ")) << key;
+  EXPECT_TRUE(contains(key, "\nfile series.csv ")) << key;
+  EXPECT_TRUE(contains(key, "binary=")) << key;
+}
+
+}  // namespace
