@@ -21,6 +21,9 @@ trap 'rm -f "$tmp"' EXIT
   echo "when cases are missing. Numbers must be finite (no NaN, inf or trailing text). \`--t-end\`"
   echo "takes a number, \`ref\` (the problem's reference time; its default horizon if it has none) or"
   echo "\`default\` (the problem's default horizon), as \`t_end\` does in matrix files (docs/matrix.md)."
+  echo "An integrator's settings beyond step and tolerances are part of its name: the ARKODE"
+  echo "Butcher table is \`ark-erk-<table>\` / \`ark-dirk-<table>\` (\`cstab list\`, docs/methods.md); an"
+  echo "unknown table is bad input (exit 2) and the message names the valid ones."
   echo
   echo '```'
   "$B" --help
