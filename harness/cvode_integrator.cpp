@@ -98,6 +98,17 @@ class CvodeIntegrator final : public Integrator {
     ready_ = setup(t0);
   }
 
+  // In one-step mode the output time only sizes the solver's first trial
+  // step after a (re)start (at most a tenth of the distance, less if the
+  // solver's own estimate says so); the stop time is what bounds the step.
+  // A far limit (1e300: "no limit") made that trial step absurd (h = 2e133
+  // on the wheel at rest, then repeated failures), so the distance is capped
+  // at 1 time unit, or 1e4 times the last step after a restart.
+  double heuristic_tout(double t_limit) const {
+    const double span = h_used_ > 0 ? 1e4 * h_used_ : 1.0;
+    return std::min(t_limit, t_ + span);
+  }
+
   StepOutcome step(double t_limit) override {
     if (!ready_) {
       if (failure_.empty()) failure_ = "cvode: not started";
@@ -107,7 +118,7 @@ class CvodeIntegrator final : public Integrator {
     int flag = CVodeSetStopTime(mem_, t_limit);
     if (flag < 0) return fail(flag, "CVodeSetStopTime");
     double t_returned = t_;
-    flag = CVode(mem_, t_limit, yy_, &t_returned, CV_ONE_STEP);
+    flag = CVode(mem_, heuristic_tout(t_limit), yy_, &t_returned, CV_ONE_STEP);
     refresh_counts();
     if (flag < 0) return fail(flag, "CVode");
     t_ = t_returned;

@@ -247,8 +247,11 @@ std::vector<Case> harness_cases() {
   for (const auto& c : all_cases())
     // (projection restarts msbdf after every step, with a new Jacobian:
     // seconds per run; StepLoop covers that pair.)
+    // (Likewise CVODE, restarted at order 1 after every projection step.)
     if (c.integrator == "adams" || c.integrator == "rk8pd" || c.integrator == "ida" ||
-        (c.integrator == "msbdf" && c.method != "projection"))
+        c.integrator == "ark-erk-dp5" ||
+        ((c.integrator == "msbdf" || c.integrator == "cvode-bdf") && c.method != "projection" &&
+         c.method != "post-stabilization"))
       out.push_back(c);
   return out;
 }
