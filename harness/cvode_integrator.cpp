@@ -226,6 +226,9 @@ class CvodeIntegrator final : public Integrator {
     int flag = CVodeInit(mem_, &CvodeIntegrator::rhs_callback, t0, yy_);
     if (flag == CV_SUCCESS) flag = CVodeSetUserData(mem_, this);
     if (flag == CV_SUCCESS) flag = CVodeSStolerances(mem_, settings_.rtol, settings_.atol);
+    // As for ARKODE (arkode_integrator.cpp): 20 error-test failures in one
+    // step before giving up, not CVODE's default 7.
+    if (flag == CV_SUCCESS) flag = CVodeSetMaxErrTestFails(mem_, 20);
     if (flag != CV_SUCCESS) return setup_failed(cvode_flag_words(flag));
     if (bdf_) {
       matrix_ = SUNDenseMatrix(n_, n_, ctx_);
