@@ -32,6 +32,10 @@ const std::vector<IntegratorInfo>& all_integrators() {
                     "difference-quotient Jacobian", false, 5},
       {"cvode-adams", "SUNDIALS CVODE variable-order Adams-Moulton (orders 1-12), adaptive, fixed-point iteration",
        false, 12},
+      {"cvode-projection", "cvode-bdf with the method's post-step projection inside CVODE (CVodeSetProjFn, "
+                           "projected error estimate): no restart after a projection", false, 5},
+      {"cvode-projection-noerr", "cvode-projection without projecting the error estimate (CVodeSetProjErrEst off)",
+       false, 5},
     };
     add_arkode_integrators(l);
     return l;
@@ -303,7 +307,8 @@ class GslAdaptive final : public Integrator {
 }  // namespace
 
 std::unique_ptr<Integrator> make_ida_integrator(const StepSettings& settings);  // ida_integrator.cpp
-std::unique_ptr<Integrator> make_cvode_integrator(const StepSettings& settings, bool bdf);  // cvode_integrator.cpp
+// cvode_integrator.cpp; projection: 0 none, 1 CVodeSetProjFn with the error projected, 2 without
+std::unique_ptr<Integrator> make_cvode_integrator(const StepSettings& settings, bool bdf, int projection = 0);
 std::unique_ptr<Integrator> make_arkode_integrator(const std::string& name, const StepSettings& settings);
 
 std::unique_ptr<Integrator> make_integrator(const std::string& name, const StepSettings& s) {
@@ -329,6 +334,8 @@ std::unique_ptr<Integrator> make_integrator(const std::string& name, const StepS
   if (name == "ida") return make_ida_integrator(s);
   if (name == "cvode-bdf") return make_cvode_integrator(s, true);
   if (name == "cvode-adams") return make_cvode_integrator(s, false);
+  if (name == "cvode-projection") return make_cvode_integrator(s, true, 1);
+  if (name == "cvode-projection-noerr") return make_cvode_integrator(s, true, 2);
   if (auto ark = make_arkode_integrator(name, s)) return ark;
   throw UsageError("--integrator " + name + ": not constructible");
 }

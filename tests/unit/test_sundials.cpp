@@ -311,3 +311,44 @@ TEST(PostStabilization, RefactorIsZeroOrOne) {
 
 }  // namespace
 }  // namespace cstab
+
+namespace cstab {
+namespace {
+
+// cvode-projection: the method's projection inside CVODE (CVodeSetProjFn)
+// keeps BDF's history, where the harness's post-step projection restarts
+// CVODE at order 1 after every step (ordering: far fewer steps, a smaller
+// error; the residual stays at projection's level).
+TEST(CvodeProjection, KeepsTheHistoryWhereARestartLosesIt) {
+  const Problem& p = find_problem("slider-crank");
+  auto run = [&](const std::string& integrator, const std::string& method) {
+    RunConfig cfg;
+    cfg.problem = "slider-crank";
+    cfg.method = method;
+    cfg.integrator = integrator;
+    cfg.step.rtol = cfg.step.atol = 1e-8;
+    cfg.t_end = 1.0;
+    cfg.ref_time = 1.0;
+    cfg.write_series = false;
+    return run_case(p, cfg, "");
+  };
+  for (const char* method : {"projection", "post-stabilization"}) {
+    const RunResult restart = run("cvode-bdf", method);
+    const RunResult inside = run("cvode-projection", method);
+    const RunResult inside_noerr = run("cvode-projection-noerr", method);
+    for (const RunResult* r : {&restart, &inside, &inside_noerr}) {
+      ASSERT_EQ(r->status, "ok") << r->integrator << " " << method << ": " << r->reason;
+      EXPECT_LT(r->max_residual, 1e-12) << r->integrator << " " << method;
+    }
+    EXPECT_LT(inside.steps * 20, restart.steps) << method;
+    EXPECT_LT(inside_noerr.steps * 20, restart.steps) << method;
+    EXPECT_LT(inside.ref_error, restart.ref_error) << method;
+    bool counted = false;
+    for (const auto& [key, value] : inside.extra)
+      if (key == "cvode_projections") counted = std::stol(value) >= inside.steps;
+    EXPECT_TRUE(counted) << "cvode_projections >= steps";
+  }
+}
+
+}  // namespace
+}  // namespace cstab
