@@ -102,6 +102,7 @@ class CvodeIntegrator final : public Integrator {
     projected_form_ = projection_ != 0 && form && form->has_post_step() ? form : nullptr;
     proj_y_.assign(n_, 0);
     proj_e_.assign(n_, 0);
+    proj_p_.assign(n_, 0);
     ready_ = setup(t0);
   }
 
@@ -111,12 +112,12 @@ class CvodeIntegrator final : public Integrator {
   // step after a (re)start (at most a tenth of the distance, less if the
   // solver's own estimate says so); the stop time is what bounds the step.
   // A far limit (1e300: "no limit") made the first trial step absurd
-  // (h = 2e133 on the wheel at rest, then repeated failures), so before the
-  // first step the distance is capped at 1 time unit. After a restart the
-  // limit itself is used: capping it at 1e4 times the last step made
-  // cvode-bdf with projection take 14 million steps to t = 0.1 on the
-  // slider crank (measured; 214812 to t = 10 with the limit).
-  double heuristic_tout(double t_limit) const { return h_used_ > 0 ? t_limit : std::min(t_limit, t_ + 1.0); }
+  // (h = 2e133 on the wheel at rest, then repeated failures), so the
+  // distance is capped at 1 time unit. (Capping it at 1e4 times the last
+  // step after a restart made cvode-bdf with projection take 14 million
+  // steps to t = 0.1 on the slider crank, measured: the trial step then
+  // shrinks with the last one.)
+  double heuristic_tout(double t_limit) const { return std::min(t_limit, t_ + 1.0); }
 
   StepOutcome step(double t_limit) override {
     if (!ready_) {
@@ -269,7 +270,7 @@ class CvodeIntegrator final : public Integrator {
   // method's own post-step hook (projection: mass-weighted Gauss-Newton on
   // the positions, then the velocities; post-stabilization: one
   // correction). With the error estimate projected, err becomes
-  // Proj(ycur + corr + err) - (ycur + corr): its part along the manifold.
+  // Proj(p + err) - Proj(p), p = ycur + corr: its part along the manifold.
   static int projection_callback(realtype t, N_Vector ycur, N_Vector corr, realtype, N_Vector err,
                                  void* user_data) {
     auto* self = static_cast<CvodeIntegrator*>(user_data);
@@ -285,11 +286,18 @@ class CvodeIntegrator final : public Integrator {
       if (!std::isfinite(c[i])) return 1;  // recoverable: CVODE retries with a smaller step
     }
     if (err) {
+      // Linearized: Proj(p + e) - Proj(p), so that a hook that is not
+      // idempotent (post-stabilization's single correction) does not add
+      // its own correction of p to the error (measured: with
+      // Proj(p + e) - p, biped with post-stabilization failed at t = 0, the
+      // error test failing down to h = 1e-29).
       double* e = N_VGetArrayPointer(err);
       double* pe = self->proj_e_.data();
-      for (int i = 0; i < n; ++i) pe[i] = p[i] + e[i];
+      double* pp = self->proj_p_.data();
+      for (int i = 0; i < n; ++i) pe[i] = p[i] + e[i], pp[i] = p[i];
       self->projected_form_->post_step(t, pe);
-      for (int i = 0; i < n; ++i) e[i] = pe[i] - p[i];
+      self->projected_form_->post_step(t, pp);
+      for (int i = 0; i < n; ++i) e[i] = pe[i] - pp[i];
     }
     return 0;
   }
@@ -348,7 +356,7 @@ class CvodeIntegrator final : public Integrator {
   bool bdf_;
   int projection_;  // 0 none, 1 CVodeSetProjFn with the error estimate projected, 2 without
   Formulation* projected_form_ = nullptr;
-  std::vector<double> proj_y_, proj_e_;
+  std::vector<double> proj_y_, proj_e_, proj_p_;
   long projections_ = 0;
   SUNContext ctx_ = nullptr;
   void* mem_ = nullptr;
