@@ -8,6 +8,11 @@
 //   cvode-adams : variable-order Adams-Moulton (orders 1-12), fixed-point
 //                 (functional) iteration: no Jacobian, no linear solver, the
 //                 usual choice for non-stiff problems.
+//   cvode-projection(-noerr) : cvode-bdf with the formulation's post-step
+//                 hook as CVODE's projection function (CVodeSetProjFn), with
+//                 the error estimate projected or not (CVodeSetProjErrEst);
+//                 the harness then leaves the hook to the integrator
+//                 (applies_post_step) and CVODE keeps its history.
 // Tolerances: scalar rtol and atol (CVodeSStolerances).
 //
 // After a post-step hook changed y() (projection), notify_modified()
