@@ -66,6 +66,21 @@ integrators = ["ida"]
 tol = [1e-6, 1e-8, 1e-10]
 optional = true
 
+# SUNDIALS ODE integrators (docs/methods.md): ARKODE's explicit Fehlberg 8(7)
+# on every method, CVODE's BDF on the methods without a post-step (a
+# projection restarts it at order 1 after every step).
+[[sweep]]
+name = "wp-ark-erk"
+integrators = ["ark-erk-fehlberg8"]
+tol = [1e-6, 1e-9]
+param.braun-goldfarb.dt = 1e-3
+
+[[sweep]]
+name = "wp-cvode-bdf"
+methods = ["pesterev", "baumgarte", "none", "minimal"]
+integrators = ["cvode-bdf"]
+tol = [1e-6, 1e-9]
+
 # The problem's own horizon, one setting for every method: residual and
 # drift against time (the overlays).
 [[sweep]]

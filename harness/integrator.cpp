@@ -13,8 +13,12 @@
 
 namespace cstab {
 
+void add_arkode_integrators(std::vector<IntegratorInfo>& list);         // arkode_integrator.cpp
+std::string arkode_unknown_table(const std::string& name);              // arkode_integrator.cpp
+
 const std::vector<IntegratorInfo>& all_integrators() {
-  static const std::vector<IntegratorInfo> list = {
+  static const std::vector<IntegratorInfo> list = [] {
+    std::vector<IntegratorInfo> l = {
       {"euler", "explicit (forward) Euler, fixed step", true, 1},
       {"rk4", "classical 4th-order Runge-Kutta, fixed step", true, 4},
       {"adams", "Adams-Bashforth-Moulton PECE, 4th order, fixed step (RK4 start-up)", true, 4},
@@ -24,13 +28,25 @@ const std::vector<IntegratorInfo>& all_integrators() {
       {"msbdf", "GSL variable-order BDF (orders 1-5), adaptive, implicit", false, 5},
       {"ida", "SUNDIALS IDA variable-order BDF (orders 1-5) for DAEs F(t, y, y') = 0, adaptive; "
               "needs a DAE method (ida-index1, ida-ggl)", false, 5, true},
-  };
+      {"cvode-bdf", "SUNDIALS CVODE variable-order BDF (orders 1-5), adaptive, implicit: Newton with a dense "
+                    "difference-quotient Jacobian", false, 5},
+      {"cvode-adams", "SUNDIALS CVODE variable-order Adams-Moulton (orders 1-12), adaptive, fixed-point iteration",
+       false, 12},
+      {"cvode-projection", "cvode-bdf with the method's post-step projection inside CVODE (CVodeSetProjFn, "
+                           "projected error estimate): no restart after a projection", false, 5},
+      {"cvode-projection-noerr", "cvode-projection without projecting the error estimate (CVodeSetProjErrEst off)",
+       false, 5},
+    };
+    add_arkode_integrators(l);
+    return l;
+  }();
   return list;
 }
 
 const IntegratorInfo& find_integrator(const std::string& name) {
   for (const auto& i : all_integrators())
     if (i.name == name) return i;
+  if (const std::string why = arkode_unknown_table(name); !why.empty()) throw UsageError(why);
   std::string known;
   for (const auto& i : all_integrators()) known += (known.empty() ? "" : ", ") + i.name;
   throw UsageError("--integrator " + name + ": unknown integrator (known: " + known + ")");
@@ -291,6 +307,9 @@ class GslAdaptive final : public Integrator {
 }  // namespace
 
 std::unique_ptr<Integrator> make_ida_integrator(const StepSettings& settings);  // ida_integrator.cpp
+// cvode_integrator.cpp; projection: 0 none, 1 CVodeSetProjFn with the error projected, 2 without
+std::unique_ptr<Integrator> make_cvode_integrator(const StepSettings& settings, bool bdf, int projection = 0);
+std::unique_ptr<Integrator> make_arkode_integrator(const std::string& name, const StepSettings& settings);
 
 std::unique_ptr<Integrator> make_integrator(const std::string& name, const StepSettings& s) {
   static const bool gsl_quiet = [] { gsl_set_error_handler_off(); return true; }();
@@ -313,6 +332,11 @@ std::unique_ptr<Integrator> make_integrator(const std::string& name, const StepS
   if (name == "msadams") return std::make_unique<GslAdaptive>(gsl_odeiv2_step_msadams, s);
   if (name == "msbdf") return std::make_unique<GslAdaptive>(gsl_odeiv2_step_msbdf, s);
   if (name == "ida") return make_ida_integrator(s);
+  if (name == "cvode-bdf") return make_cvode_integrator(s, true);
+  if (name == "cvode-adams") return make_cvode_integrator(s, false);
+  if (name == "cvode-projection") return make_cvode_integrator(s, true, 1);
+  if (name == "cvode-projection-noerr") return make_cvode_integrator(s, true, 2);
+  if (auto ark = make_arkode_integrator(name, s)) return ark;
   throw UsageError("--integrator " + name + ": not constructible");
 }
 

@@ -47,6 +47,10 @@ class Integrator {
   virtual bool state_at(double t_target, double* out) = 0;
   // After the caller changed y() in place (projection): refresh any history.
   virtual bool notify_modified() = 0;
+  // True if the integrator applies the formulation's post-step hook itself,
+  // inside each step (cvode-projection: CVODE's projection interface keeps
+  // the projected state in its history); the caller then must not.
+  virtual bool applies_post_step() const { return false; }
 
   double t() const { return t_; }
   double* y() { return y_.data(); }

@@ -346,7 +346,8 @@ RunResult run_case(const Problem& problem, const RunConfig& cfg, const std::stri
         alive = false;
         break;
       }
-      if (form->has_post_step() && form->post_step(integrator->t(), integrator->y())) {
+      if (form->has_post_step() && !integrator->applies_post_step() &&
+          form->post_step(integrator->t(), integrator->y())) {
         if (!integrator->notify_modified()) {
           result.status = "failed";
           result.reason = integrator->failure_reason();

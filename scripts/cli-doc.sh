@@ -25,6 +25,9 @@ trap 'rm -f "$tmp"' EXIT
   echo "starts, an adaptive one stops there (status \`failed\`); \`stability\` bounds the steps of a whole map."
   echo "\`matrix\`, \`merge\`, \`report\` and \`gate --update\` lock the results folder (\`DIR/.cstab.lock\`): a second"
   echo "one on the same folder exits 2 at once, naming the holder's pid."
+  echo "An integrator's settings beyond step and tolerances are part of its name: the ARKODE"
+  echo "Butcher table is \`ark-erk-<table>\` / \`ark-dirk-<table>\` (\`cstab list\`, docs/methods.md); an"
+  echo "unknown table is bad input (exit 2) and the message names the valid ones."
   echo
   echo '```'
   "$B" --help
