@@ -64,6 +64,14 @@ integrators = ["ida"]
 tol = [1e-6, 1e-8, 1e-10]
 optional = true
 
+# The generalized-alpha family: each method is its own implicit fixed-step
+# scheme (integrator "own"); three steps keep it to seconds per problem.
+[[sweep]]
+name = "wp-own"
+methods = ["generalized-alpha", "hht", "generalized-alpha-i2"]
+integrators = ["own"]
+step = [1e-2, 3e-3, 1e-3]
+
 # The problem's own horizon, one setting for every method: residual and
 # drift against time (the overlays).
 [[sweep]]

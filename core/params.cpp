@@ -41,15 +41,36 @@ Params Params::resolve(const std::vector<ParamSpec>& specs,
     if (std::find(p.given_.begin(), p.given_.end(), name) != p.given_.end())
       throw UsageError("--param " + name + ": given more than once");
     const double value = parse_finite_double(text, "--param " + name);
-    if (it->bound == Bound::kPositive && !(value > 0))
-      throw UsageError("--param " + name + "=" + text + ": must be > 0");
-    if (it->bound == Bound::kNonNegative && !(value >= 0))
-      throw UsageError("--param " + name + "=" + text + ": must be >= 0");
+    if (const std::string bad = bound_violation(*it, value); !bad.empty())
+      throw UsageError("--param " + name + "=" + text + ": " + bad);
     for (auto& [n, v] : p.values_)
       if (n == name) v = value;
     p.given_.push_back(name);
   }
   return p;
+}
+
+std::string bound_text(const ParamSpec& spec) {
+  switch (spec.bound) {
+    case Bound::kPositive: return "> 0";
+    case Bound::kNonNegative: return ">= 0";
+    case Bound::kRange: return "in [" + format_short(spec.lower) + ", " + format_short(spec.upper) + "]";
+    case Bound::kInteger:
+      return "an integer in [" + format_short(spec.lower) + ", " + format_short(spec.upper) + "]";
+    default: return "any";
+  }
+}
+
+std::string bound_violation(const ParamSpec& spec, double value) {
+  bool ok = true;
+  switch (spec.bound) {
+    case Bound::kPositive: ok = value > 0; break;
+    case Bound::kNonNegative: ok = value >= 0; break;
+    case Bound::kRange: ok = value >= spec.lower && value <= spec.upper; break;
+    case Bound::kInteger: ok = value >= spec.lower && value <= spec.upper && value == std::floor(value); break;
+    default: break;
+  }
+  return ok ? "" : "must be " + bound_text(spec);
 }
 
 double Params::get(const std::string& name) const {

@@ -129,8 +129,7 @@ std::vector<Case> all_cases() {
           continue;  // the method does not run on this formulation
         }
         for (const auto& integ : all_integrators()) {
-          const bool dae_method = m.name.rfind("ida", 0) == 0;
-          if (dae_method != integ.solves_dae) continue;
+          if (m.kind != integ.kind) continue;
           out.push_back({p->info().name, m.name, f.name, integ.name});
         }
       }
@@ -247,7 +246,7 @@ std::vector<Case> harness_cases() {
   for (const auto& c : all_cases())
     // (projection restarts msbdf after every step, with a new Jacobian:
     // seconds per run; StepLoop covers that pair.)
-    if (c.integrator == "adams" || c.integrator == "rk8pd" || c.integrator == "ida" ||
+    if (c.integrator == "adams" || c.integrator == "rk8pd" || c.integrator == "ida" || c.integrator == "own" ||
         (c.integrator == "msbdf" && c.method != "projection"))
       out.push_back(c);
   return out;
