@@ -356,7 +356,8 @@ TEST(GeneralizedAlphaCli, BadParametersExitTwoWithOneLineAndNoOutput) {
   // The range is named in the message.
   testing::Scratch s("cstab_genalpha_cli");
   const CliOutcome o = run_cli({"run", "--problem", "slider-crank", "--method", "generalized-alpha", "--integrator",
-                                "own", "--step", "1e-3", "--param", "rho_inf=1.5"},
+                                "own", "--step", "1e-3", "--t-end", "0.1", "--param", "rho_inf=1.5", "--out",
+                                (s.dir() / "out").string()},
                                s.dir());
   EXPECT_NE(o.err.find("[0, 1]"), std::string::npos) << o.err;
 }
