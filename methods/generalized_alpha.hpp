@@ -150,7 +150,9 @@ class GeneralizedAlphaFormulation final : public MechanicalFormulationBase<Model
   bool has_condition_number() const override { return step_hint_ > 0; }
   double condition_number(double t, const double* y) override {
     if (!(step_hint_ > 0)) return std::nan("");
+    const long counted = evaluations_;  // an observation, not a step's work
     const MatN S = newton_matrix(t, y, step_hint_, true);
+    evaluations_ = counted;
     return linalg::condition_number(S.data(), kN);
   }
 
