@@ -20,14 +20,6 @@ namespace cstab::cli {
 
 namespace {
 
-std::string bound_text(Bound b) {
-  switch (b) {
-    case Bound::kPositive: return "> 0";
-    case Bound::kNonNegative: return ">= 0";
-    default: return "any";
-  }
-}
-
 // Names of the integrators that take --step (fixed) or --rtol/--atol.
 std::string integrator_names(bool fixed_step) {
   std::string names;
@@ -69,7 +61,7 @@ int cmd_list(const Args&) {
   for (const auto& m : all_methods()) {
     out << "  " << m.name << ": " << m.description << "\n";
     for (const auto& s : m.params)
-      out << "    --param " << s.name << "=" << format_short(s.default_value) << "  (" << bound_text(s.bound)
+      out << "    --param " << s.name << "=" << format_short(s.default_value) << "  (" << bound_text(s)
           << ") " << s.description << "\n";
   }
   out << "INTEGRATORS\n";

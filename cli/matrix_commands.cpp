@@ -81,6 +81,14 @@ methods = ["pesterev", "baumgarte", "none", "minimal"]
 integrators = ["cvode-bdf"]
 tol = [1e-6, 1e-9]
 
+# The generalized-alpha family: each method is its own implicit fixed-step
+# scheme (integrator "own"); three steps keep it to seconds per problem.
+[[sweep]]
+name = "wp-own"
+methods = ["generalized-alpha", "hht", "generalized-alpha-i2"]
+integrators = ["own"]
+step = [1e-2, 3e-3, 1e-3]
+
 # The problem's own horizon, one setting for every method: residual and
 # drift against time (the overlays).
 [[sweep]]

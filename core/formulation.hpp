@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace cstab {
@@ -46,6 +47,28 @@ class DaeSystem {
   virtual int index() const { return 1; }
   // r = F(t, y, y'). Returns false if F cannot be evaluated at this point.
   virtual bool residual(double t, const double* y, const double* yp, double* r) = 0;
+};
+
+// A method that is its own time-stepping scheme (the generalized-alpha
+// family): an implicit step with a Newton iteration of its own, not a
+// right-hand side. It runs only on the "own" integrator, which calls
+// advance() on the fixed grid t0 + k h. Like a DaeSystem, a Formulation that
+// steps itself derives from both; its state is [q; v; ...extra] (extra: the
+// scheme's accelerations and multipliers), so the observables read the same
+// array, and its rhs() fails, saying it needs --integrator own.
+// Formulation::initial_state gives a complete starting state (the scheme's
+// accelerations included).
+class SteppingSystem {
+ public:
+  virtual ~SteppingSystem() = default;
+  // y (dimension() doubles) from t to t + h, in place. Returns false if the
+  // step failed (OdeSystem::failure_reason() says why); y is then unspecified.
+  // Must not allocate.
+  virtual bool advance(double t, double h, double* y) = 0;
+  // Evaluations of the model's residuals with their Jacobians (for rhs_evals).
+  virtual long evaluations() const = 0;
+  // Scheme-specific counters (name, value), appended to the summary row.
+  virtual std::vector<std::pair<std::string, std::string>> statistics() const { return {}; }
 };
 
 struct ConstraintInfo {

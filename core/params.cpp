@@ -26,8 +26,7 @@ double parse_finite_double(const std::string& text, const std::string& what) {
 }
 
 std::string param_value_problem(const ParamSpec& spec, double value) {
-  if (spec.bound == Bound::kPositive && !(value > 0)) return "must be > 0";
-  if (spec.bound == Bound::kNonNegative && !(value >= 0)) return "must be >= 0";
+  if (std::string bad = bound_violation(spec, value); !bad.empty()) return bad;
   if (spec.integer && value != std::floor(value)) return "must be a whole number";
   if (!(value <= spec.max_value)) return "must be <= " + format_short(spec.max_value);
   return "";
@@ -60,6 +59,29 @@ Params Params::resolve(const std::vector<ParamSpec>& specs,
     p.given_.push_back(name);
   }
   return p;
+}
+
+std::string bound_text(const ParamSpec& spec) {
+  switch (spec.bound) {
+    case Bound::kPositive: return "> 0";
+    case Bound::kNonNegative: return ">= 0";
+    case Bound::kRange: return "in [" + format_short(spec.lower) + ", " + format_short(spec.upper) + "]";
+    case Bound::kInteger:
+      return "an integer in [" + format_short(spec.lower) + ", " + format_short(spec.upper) + "]";
+    default: return "any";
+  }
+}
+
+std::string bound_violation(const ParamSpec& spec, double value) {
+  bool ok = true;
+  switch (spec.bound) {
+    case Bound::kPositive: ok = value > 0; break;
+    case Bound::kNonNegative: ok = value >= 0; break;
+    case Bound::kRange: ok = value >= spec.lower && value <= spec.upper; break;
+    case Bound::kInteger: ok = value >= spec.lower && value <= spec.upper && value == std::floor(value); break;
+    default: break;
+  }
+  return ok ? "" : "must be " + bound_text(spec);
 }
 
 double Params::get(const std::string& name) const {

@@ -17,7 +17,8 @@ struct UsageError : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
-enum class Bound { kAny, kPositive, kNonNegative };
+// kRange: a value in [lower, upper]; kInteger: an integer in [lower, upper].
+enum class Bound { kAny, kPositive, kNonNegative, kRange, kInteger };
 
 // What a parameter is to the harness, so that stability maps, stress tables
 // and the report find "the gain" of any method without knowing its names.
@@ -40,9 +41,24 @@ struct ParamSpec {
   // checked before anything converts it to an int.
   bool integer = false;
   double max_value = std::numeric_limits<double>::infinity();
+  double lower = 0, upper = 0;  // kRange, kInteger
 };
 
-// Why `value` is not allowed for `spec` ("must be > 0", ...); "" if it is.
+// A setting in the closed interval [lower, upper] (integer: whole numbers only).
+inline ParamSpec ranged_param(std::string name, double default_value, double lower, double upper,
+                              std::string description, bool integer = false) {
+  ParamSpec s{std::move(name), default_value, integer ? Bound::kInteger : Bound::kRange, std::move(description)};
+  s.lower = lower;
+  s.upper = upper;
+  return s;
+}
+
+// The bound in words ("> 0", "in [0, 1]", "an integer in [1, 100]"; "any").
+std::string bound_text(const ParamSpec& spec);
+// "" if `value` satisfies the spec's bound; otherwise "must be <bound_text>".
+std::string bound_violation(const ParamSpec& spec, double value);
+// Why `value` is not allowed for `spec` (its bound, then `integer` and
+// `max_value`: "must be > 0", "must be a whole number", ...); "" if it is.
 std::string param_value_problem(const ParamSpec& spec, double value);
 
 // The method's gain: its first kRate or kTimeScale parameter (nullptr if none).

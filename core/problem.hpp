@@ -49,11 +49,18 @@ struct ConformanceSettings {
   double drift_bound = 1e-4;    // max |residual| allowed to a method that does not stabilize
 };
 
+// What a method hands the integrator, and so which integrators run it.
+enum class MethodKind {
+  kOde,           // y' = f(t, y): the ODE integrators
+  kDae,           // F(t, y, y') = 0 (a DaeSystem): "ida"
+  kSelfStepping,  // its own implicit scheme (a SteppingSystem): "own"
+};
+
 struct MethodInfo {
   std::string name;
   std::string description;
   std::vector<ParamSpec> params;
-  bool is_dae = false;  // a DAE formulation F(t, y, y') = 0: runs only on a DAE integrator
+  MethodKind kind = MethodKind::kOde;  // runs only on integrators of the same kind
   ConformanceSettings conformance = {};
 };
 

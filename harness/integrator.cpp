@@ -27,7 +27,7 @@ const std::vector<IntegratorInfo>& all_integrators() {
       {"msadams", "GSL variable-order Adams (orders 1-12), adaptive", false, 12},
       {"msbdf", "GSL variable-order BDF (orders 1-5), adaptive, implicit", false, 5},
       {"ida", "SUNDIALS IDA variable-order BDF (orders 1-5) for DAEs F(t, y, y') = 0, adaptive; "
-              "needs a DAE method (ida-index1, ida-ggl)", false, 5, true},
+              "needs a DAE method (ida-index1, ida-ggl)", false, 5, MethodKind::kDae},
       {"cvode-bdf", "SUNDIALS CVODE variable-order BDF (orders 1-5), adaptive, implicit: Newton with a dense "
                     "difference-quotient Jacobian", false, 5},
       {"cvode-adams", "SUNDIALS CVODE variable-order Adams-Moulton (orders 1-12), adaptive, fixed-point iteration",
@@ -36,6 +36,8 @@ const std::vector<IntegratorInfo>& all_integrators() {
                            "projected error estimate): no restart after a projection", false, 5},
       {"cvode-projection-noerr", "cvode-projection without projecting the error estimate (CVodeSetProjErrEst off)",
        false, 5},
+      {"own", "the method's own implicit fixed-step scheme (generalized-alpha, hht, generalized-alpha-i2); "
+              "off-grid output by a side step of the scheme", true, 2, MethodKind::kSelfStepping},
     };
     add_arkode_integrators(l);
     return l;
@@ -50,6 +52,28 @@ const IntegratorInfo& find_integrator(const std::string& name) {
   std::string known;
   for (const auto& i : all_integrators()) known += (known.empty() ? "" : ", ") + i.name;
   throw UsageError("--integrator " + name + ": unknown integrator (known: " + known + ")");
+}
+
+MethodKind method_kind_of(const Formulation& form) {
+  if (dynamic_cast<const DaeSystem*>(&form)) return MethodKind::kDae;
+  if (dynamic_cast<const SteppingSystem*>(&form)) return MethodKind::kSelfStepping;
+  return MethodKind::kOde;
+}
+
+std::string pairing_error(MethodKind method, const std::string& name, const IntegratorInfo& integ) {
+  if (method == integ.kind) return "";
+  const std::string flag = "--integrator " + integ.name + ": ";
+  if (method == MethodKind::kDae)
+    return flag + "method '" + name +
+           "' is a DAE formulation F(t, y, y') = 0 and needs a DAE integrator (--integrator ida)";
+  if (method == MethodKind::kSelfStepping)
+    return flag + "method '" + name +
+           "' is its own implicit time-stepping scheme and runs only with --integrator own";
+  if (integ.kind == MethodKind::kDae)
+    return flag + "solves DAEs F(t, y, y') = 0, but method '" + name +
+           "' is an ODE formulation; use a DAE method (ida-index1, ida-ggl)";
+  return flag + "steps methods that are their own implicit scheme (generalized-alpha, hht, "
+                "generalized-alpha-i2), but method '" + name + "' is an ODE formulation; use an ODE integrator";
 }
 
 bool Integrator::eval(double t, const double* y, double* dydt) {
@@ -197,6 +221,52 @@ class AdamsPece final : public FixedStep {
   bool have_history_ = false;
 };
 
+// "own": the fixed grid of FixedStep, each step the method's own scheme
+// (SteppingSystem::advance). An output time between grid points is reached
+// by a side step of the scheme itself from the last grid point (of size
+// t_target - t), which leaves the trajectory on the grid undisturbed.
+class OwnScheme final : public FixedStep {
+ public:
+  using FixedStep::FixedStep;
+  bool notify_modified() override { return true; }
+
+  bool state_at(double t_target, double* out) override {
+    std::copy(y_.begin(), y_.end(), out);
+    const double dt = t_target - t_;
+    if (dt == 0) return true;
+    if (!ready()) return false;
+    const bool ok = scheme_->advance(t_, dt, out);
+    if (!ok) failure_ = reason();
+    rhs_evals_ = scheme_->evaluations();
+    return ok;
+  }
+
+  std::vector<std::pair<std::string, std::string>> statistics() const override {
+    return scheme_ ? scheme_->statistics() : std::vector<std::pair<std::string, std::string>>{};
+  }
+
+ private:
+  void on_start() override { scheme_ = dynamic_cast<SteppingSystem*>(sys_); }
+  bool ready() {
+    if (scheme_) return true;
+    failure_ = "own: the method is not its own time-stepping scheme (use an ODE integrator)";
+    return false;
+  }
+  std::string reason() const {
+    const std::string& r = sys_->failure_reason();
+    return r.empty() ? "the method's step failed" : r;
+  }
+  bool advance(double t_next) override {
+    if (!ready()) return false;
+    const bool ok = scheme_->advance(t_, t_next - t_, y_.data());
+    rhs_evals_ = scheme_->evaluations();
+    if (!ok) failure_ = reason();
+    return ok;
+  }
+
+  SteppingSystem* scheme_ = nullptr;
+};
+
 // What a GSL odeiv2 evolve status means, in words (gsl_strerror alone says
 // "failure" for the step-size underflow).
 std::string gsl_failure_words(int status, double t, double h) {
@@ -337,6 +407,7 @@ std::unique_ptr<Integrator> make_integrator(const std::string& name, const StepS
   if (name == "cvode-projection") return make_cvode_integrator(s, true, 1);
   if (name == "cvode-projection-noerr") return make_cvode_integrator(s, true, 2);
   if (auto ark = make_arkode_integrator(name, s)) return ark;
+  if (name == "own") return std::make_unique<OwnScheme>(s.step);
   throw UsageError("--integrator " + name + ": not constructible");
 }
 

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "core/formulation.hpp"
+#include "core/problem.hpp"
 
 namespace cstab {
 
@@ -19,7 +20,9 @@ struct IntegratorInfo {
   std::string description;
   bool fixed_step;  // needs --step; otherwise needs --rtol/--atol
   int order;        // classical order of accuracy
-  bool solves_dae = false;  // steps F(t, y, y') = 0 (a DaeSystem), not y' = f
+  // Which methods it runs: ODE right-hand sides, DAEs F(t, y, y') = 0 (a
+  // DaeSystem), or methods that step themselves (a SteppingSystem).
+  MethodKind kind = MethodKind::kOde;
 };
 
 const std::vector<IntegratorInfo>& all_integrators();
@@ -75,6 +78,12 @@ class Integrator {
   long steps_ = 0, rejected_ = 0, rhs_evals_ = 0;
   std::string failure_;
 };
+
+// The kind of method a formulation is (what it derives from).
+MethodKind method_kind_of(const Formulation& form);
+// "" if an integrator of `integrator` kind runs a method of `method` kind;
+// otherwise why not, in words (for a UsageError / a matrix note).
+std::string pairing_error(MethodKind method, const std::string& method_name, const IntegratorInfo& integrator);
 
 std::unique_ptr<Integrator> make_integrator(const std::string& name, const StepSettings& settings);
 

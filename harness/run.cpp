@@ -249,16 +249,11 @@ RunResult run_case(const Problem& problem, const RunConfig& cfg, const std::stri
   const auto specs = problem.method_params(cfg.method, cfg.formulation);
   const Params params = Params::resolve(specs, cfg.params, cfg.method);
   auto form = problem.make(cfg.method, cfg.formulation, params);
-  // A DAE formulation (F(t, y, y') = 0) needs a DAE solver, and a DAE solver
-  // needs one.
-  const bool is_dae = dynamic_cast<const DaeSystem*>(form.get()) != nullptr;
-  if (is_dae && !integ_info.solves_dae)
-    throw UsageError("--integrator " + cfg.integrator + ": method '" + cfg.method +
-                     "' is a DAE formulation F(t, y, y') = 0 and needs a DAE integrator (--integrator ida)");
-  if (!is_dae && integ_info.solves_dae)
-    throw UsageError("--integrator " + cfg.integrator + ": solves DAEs F(t, y, y') = 0, but method '" +
-                     cfg.method + "' is an ODE formulation; use a DAE method (ida-index1, ida-ggl)");
-  if (cfg.perturb > 0 && is_dae)
+  // A DAE formulation (F(t, y, y') = 0) needs a DAE solver, a method that
+  // steps itself the "own" integrator, and each of those needs one.
+  const MethodKind kind = method_kind_of(*form);
+  if (const std::string wrong = pairing_error(kind, cfg.method, integ_info); !wrong.empty()) throw UsageError(wrong);
+  if (cfg.perturb > 0 && kind != MethodKind::kOde)
     throw UsageError("--perturb: method '" + cfg.method +
                      "' makes its initial values consistent before it starts (a DAE solver needs them), "
                      "so it cannot start off the manifold");

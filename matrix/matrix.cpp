@@ -619,7 +619,7 @@ struct SweepPlan {
   bool series = true, work_precision = true, overlay = false;
   std::vector<double> perturbs;
   std::vector<ParamChoice> params;
-  size_t not_applicable = 0, wrong_integrator = 0;
+  size_t not_applicable = 0, wrong_integrator = 0, wrong_integrator_own = 0;
 };
 
 // Builds the cases of every sweep, in order, keeping identical ones once.
@@ -920,7 +920,8 @@ class Expander {
     }
     // A DAE formulation F(t, y, y') = 0 needs a DAE integrator and an
     // ODE one an ODE integrator (the method declares which it is,
-    // MethodInfo::is_dae): impossible pairs are not cases.
+    // MethodInfo::kind; likewise a method that steps itself and the "own"
+    // integrator): impossible pairs are not cases.
     const std::vector<ParamChoice*> applying = applying_params(p, info, method, specs);
     std::vector<std::string> forms;
     for (const auto* f : p.formulations) forms.push_back(f->text);
@@ -936,8 +937,9 @@ class Expander {
         }
       }
       for (const IntegratorInfo* integ : p.integrators) {
-        if (method.is_dae != integ->solves_dae) {
-          ++p.wrong_integrator;
+        if (method.kind != integ->kind) {
+          const bool own = method.kind == MethodKind::kSelfStepping || integ->kind == MethodKind::kSelfStepping;
+          ++(own ? p.wrong_integrator_own : p.wrong_integrator);
           continue;
         }
         for (const TEnd& te : p.t_ends) expand_run(p, info, method, form, *integ, te, applying);
@@ -1094,6 +1096,10 @@ class Expander {
     if (p.wrong_integrator)
       note(p, std::to_string(p.wrong_integrator) + " method x integrator combinations skipped: DAE methods (ida-*) "
               "need integrator 'ida', and 'ida' needs a DAE method");
+    if (p.wrong_integrator_own)
+      note(p, std::to_string(p.wrong_integrator_own) + " method x integrator combinations skipped: methods that are "
+              "their own scheme (generalized-alpha, hht, generalized-alpha-i2) need integrator 'own', and 'own' "
+              "needs one of them");
     if (out_.cases.size() == cases_before && duplicates_ == duplicates_before && !p.optional) {
       std::string why;
       for (size_t i = notes_before; i < out_.notes.size(); ++i) why += "; " + out_.notes[i];

@@ -7,7 +7,8 @@
 // methods/contracts.hpp; see docs/extending.md):
 //   static constexpr const char* kName, kDescription;
 //   static std::vector<ParamSpec> generic_params();   // gains declare their ParamRole
-//   static constexpr bool kIsDae;                       // optional, default false
+//   static constexpr bool kIsDae;                       // optional, default false (MethodKind::kDae)
+//   static constexpr MethodKind kKind;                  // optional, default kOde (or kDae by kIsDae)
 //   static ConformanceSettings conformance();           // optional, defaults in core/problem.hpp
 //   template <class P> static std::string why_not(const P&);          // "" = applies
 //   template <class P> static std::vector<ParamSpec> params(const P&, const std::string& formulation);
@@ -66,7 +67,8 @@ MethodInfo method_info() {
   static_assert(contracts::check_method<M>());
   if constexpr (contracts::method_ok<M>()) {
     MethodInfo info{M::kName, M::kDescription, M::generic_params()};
-    if constexpr (requires { M::kIsDae; }) info.is_dae = M::kIsDae;
+    if constexpr (requires { M::kIsDae; }) info.kind = M::kIsDae ? MethodKind::kDae : MethodKind::kOde;
+    if constexpr (requires { M::kKind; }) info.kind = M::kKind;
     if constexpr (requires { M::conformance(); }) info.conformance = M::conformance();
     return info;
   } else {

@@ -44,6 +44,11 @@ RunConfig config_for(const Problem& problem, const MethodInfo& method, double t_
   if (find_integrator(c.integrator).fixed_step) {
     cfg.step.step = std::min(c.step, t_end / 2000);
     if (problem.info().resolution_step > 0) cfg.step.step = std::min(cfg.step.step, problem.info().resolution_step);
+    // The generalized-alpha family is second order: at least 80000 steps over
+    // the horizon keep it within the suite's bounds (1e-5 against andrews'
+    // reference at 0.03 s; hht's energy drift on wheel-sharp, 1.3e-5 at
+    // h = 5e-5, 3.2e-6 at 2.5e-5, measured).
+    if (method.kind == MethodKind::kSelfStepping) cfg.step.step = std::min(cfg.step.step, t_end / 80000);
   } else {
     cfg.step.rtol = cfg.step.atol = c.tol;
   }
@@ -108,8 +113,8 @@ TEST_P(Conformance, StaysOnManifoldAndMatchesReference) {
     EXPECT_LT(r.final_residual, promise.residual_bound) << "residual at t_end";
     if (consistent_start) {
       EXPECT_LT(r.max_residual, promise.residual_bound);
-    } else if (!info.is_dae) {
-      // From an inconsistent start (DAE methods project first): recovered by
+    } else if (info.kind == MethodKind::kOde) {
+      // From an inconsistent start (DAE and self-stepping methods project first): recovered by
       // orders of magnitude, and never worse than where it started.
       EXPECT_LT(r.final_residual, 1e-3 * r0);
       EXPECT_LE(r.max_residual, 1.5 * r0);

@@ -129,8 +129,7 @@ std::vector<Case> all_cases() {
           continue;  // the method does not run on this formulation
         }
         for (const auto& integ : all_integrators()) {
-          const bool dae_method = m.name.rfind("ida", 0) == 0;
-          if (dae_method != integ.solves_dae) continue;
+          if (m.kind != integ.kind) continue;
           out.push_back({p->info().name, m.name, f.name, integ.name});
         }
       }
@@ -249,7 +248,7 @@ std::vector<Case> harness_cases() {
     // (projection restarts msbdf after every step, with a new Jacobian:
     // seconds per run; StepLoop covers that pair.)
     // (Likewise CVODE, restarted at order 1 after every projection step.)
-    if (c.integrator == "adams" || c.integrator == "rk8pd" || c.integrator == "ida" ||
+    if (c.integrator == "adams" || c.integrator == "rk8pd" || c.integrator == "ida" || c.integrator == "own" ||
         c.integrator == "ark-erk-dp5" ||
         ((c.integrator == "msbdf" || c.integrator == "cvode-bdf") && c.method != "projection" &&
          c.method != "post-stabilization"))
