@@ -1174,8 +1174,9 @@ const std::string& CsvTable::get(size_t row, const std::string& name) const {
   return rows[row][c];
 }
 
-CsvTable read_csv(const std::string& path) {
-  std::string text = read_text_file(path);
+CsvTable read_csv(const std::string& path) { return parse_csv(read_text_file(path), path); }
+
+CsvTable parse_csv(std::string text, const std::string& path) {
   if (text.rfind("\xEF\xBB\xBF", 0) == 0) text.erase(0, 3);  // a UTF-8 byte order mark: allowed, skipped
   std::vector<std::vector<std::string>> records;
   std::vector<std::string> record;

@@ -232,6 +232,8 @@ struct CsvTable {
 // an unterminated quote or a file over kMaxInputFileBytes.
 CsvTable read_csv(const std::string& path);
 std::string read_text_file(const std::string& path);  // as read_csv
+// read_csv on text already read; `path` names it in messages.
+CsvTable parse_csv(std::string text, const std::string& path);
 // The largest file cstab reads (matrix files, thresholds, results CSVs).
 inline constexpr size_t kMaxInputFileBytes = size_t(512) << 20;
 

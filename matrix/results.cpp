@@ -6,6 +6,7 @@
 #include <map>
 
 #include "core/format.hpp"
+#include "io/gzip.hpp"
 #include "io/number.hpp"
 
 namespace cstab {
@@ -216,9 +217,19 @@ ResultsFolder load_results_folder(const std::string& dir) {
   return f;
 }
 
+std::string case_series_path(const std::string& dir, const CaseEntry& entry) {
+  const std::string plain = dir + "/cases/" + entry.id + "/series.csv";
+  if (fs::exists(plain + ".gz")) return plain + ".gz";
+  return fs::exists(plain) ? plain : std::string();
+}
+
 CsvTable load_case_series(const std::string& dir, const CaseEntry& entry) {
   try {
-    return read_csv(dir + "/cases/" + entry.id + "/series.csv");
+    const std::string path = case_series_path(dir, entry);
+    if (path.empty()) return {};
+    if (path.size() > 3 && path.compare(path.size() - 3, 3, ".gz") == 0)
+      return parse_csv(gzip_decompress(read_text_file(path), kMaxInputFileBytes), path);
+    return read_csv(path);
   } catch (const std::exception&) {
     return {};
   }

@@ -111,9 +111,12 @@ ResultsFolder load_results_folder(const std::string& dir);
 // The result of one case of `dir` (complete or not).
 CaseResult load_case_result(const std::string& dir, const CaseEntry& entry);
 
-// cases/<id>/series.csv of a case; empty (no header, no rows) if it is
+// cases/<id>/series.csv.gz (or series.csv) of a case; empty (no header, no rows) if it is
 // missing or unreadable.
 CsvTable load_case_series(const std::string& dir, const CaseEntry& entry);
+// The path of a case's series: cases/<id>/series.csv.gz (what the matrix
+// writes), else cases/<id>/series.csv (older folders); "" if neither exists.
+std::string case_series_path(const std::string& dir, const CaseEntry& entry);
 
 // Configuration keys ("step=0.001;perturb=1e-3", "a=1;b=2") compared by
 // meaning: the same keys, each value equal as a number if both are

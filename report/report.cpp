@@ -141,7 +141,7 @@ std::string case_setting(const CaseResult& c) {
 }
 
 bool has_series(const std::string& dir, const CaseResult* c) {
-  return c->complete && fs::exists(dir + "/cases/" + c->entry->id + "/series.csv");
+  return c->complete && !case_series_path(dir, *c->entry).empty();
 }
 
 // Overlay run per method: the first overlay-marked case that finished
@@ -234,7 +234,7 @@ double cell(const std::vector<std::string>& row, int col) {
   return size_t(col) < row.size() ? parse_number(row[col]) : kNaN;
 }
 
-// A case's series.csv; empty if it is missing or unreadable.
+// A case's series (series.csv.gz or series.csv); empty if it is missing or unreadable.
 CsvTable read_series(const std::string& dir, const CaseResult& c) { return load_case_series(dir, *c.entry); }
 
 // Overlay data: per run, t, max |residual|, |drift|. Colours in `lcs`.

@@ -230,13 +230,13 @@ TEST_F(CrashConsistency, DamagedCachedFilesAreRerunToTheSameSummary) {
   const cstab::CsvTable cases = cstab::read_csv((out / "cases.csv").string());
   ASSERT_GE(cases.rows.size(), 6u);
   auto folder = [&](size_t i) { return out / "cases" / cases.get(i, "case_id"); };
-  fs::resize_file(folder(0) / "series.csv", 100);                             // truncated
+  fs::resize_file(folder(0) / "series.csv.gz", 100);                             // truncated
   std::ofstream(folder(1) / "summary.csv", std::ios::app) << "\n";            // edited
-  fs::remove(folder(2) / "series.csv");                                      // deleted
+  fs::remove(folder(2) / "series.csv.gz");                                      // deleted
   fs::remove(folder(3) / "summary.csv");                                     // deleted
-  fs::rename(folder(4) / "series.csv", dir_->dir() / "s4.csv");              // swapped
-  fs::copy_file(folder(5) / "series.csv", folder(4) / "series.csv");
-  fs::rename(dir_->dir() / "s4.csv", folder(5) / "series.csv");
+  fs::rename(folder(4) / "series.csv.gz", dir_->dir() / "s4.csv");              // swapped
+  fs::copy_file(folder(5) / "series.csv.gz", folder(4) / "series.csv.gz");
+  fs::rename(dir_->dir() / "s4.csv", folder(5) / "series.csv.gz");
   fs::remove(out / "summary.csv");
   const pid_t pid = spawn_matrix(toml(), out, out.string() + ".log");
   ASSERT_EQ(wait_code(pid), 0) << slurp(out.string() + ".log");

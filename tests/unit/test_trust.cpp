@@ -381,19 +381,19 @@ TEST_F(Folder, ACachedCaseWhoseFilesChangedIsRerunSayingWhy) {
   // Truncated series, edited summary, deleted series, swapped summaries.
   const fs::path c0 = dir / "cases" / id[0], c1 = dir / "cases" / id[1], c2 = dir / "cases" / id[2],
                  c3 = dir / "cases" / id[3];
-  fs::resize_file(c0 / "series.csv", fs::file_size(c0 / "series.csv") / 2);
+  fs::resize_file(c0 / "series.csv.gz", fs::file_size(c0 / "series.csv.gz") / 2);
   std::string summary = slurp(c1 / "summary.csv");
   summary[summary.size() - 2] = summary[summary.size() - 2] == '1' ? '2' : '1';
   std::ofstream(c1 / "summary.csv", std::ios::binary) << summary;
-  fs::remove(c2 / "series.csv");
+  fs::remove(c2 / "series.csv.gz");
   fs::rename(c3 / "summary.csv", dir / "tmp.csv");
   fs::copy_file(c2 / "summary.csv", c3 / "summary.csv");
   o = cstab_cmd(matrix_into(dir));
   ASSERT_EQ(o.code, 0) << o.out;
   EXPECT_TRUE(contains(o.out, "rerun ")) << o.out;
-  EXPECT_TRUE(contains(o.out, "(" + id[0] + "): series.csv has ")) << o.out;
+  EXPECT_TRUE(contains(o.out, "(" + id[0] + "): series.csv.gz has ")) << o.out;
   EXPECT_TRUE(contains(o.out, "(" + id[1] + "): summary.csv content differs from the recorded hash")) << o.out;
-  EXPECT_TRUE(contains(o.out, "(" + id[2] + "): series.csv missing")) << o.out;
+  EXPECT_TRUE(contains(o.out, "(" + id[2] + "): series.csv.gz missing")) << o.out;
   EXPECT_TRUE(contains(o.out, "(" + id[3] + "): summary.csv")) << o.out;
   EXPECT_TRUE(contains(o.out, "4 run, 0 cached")) << o.out;
   EXPECT_EQ(cstab::testing::summary_without_timing(dir / "summary.csv"), full);
@@ -405,7 +405,9 @@ TEST_F(Folder, ACachedCaseWhoseFilesChangedIsRerunSayingWhy) {
 TEST_F(Folder, KeyFilesRecordTheContentOfTheResult) {
   const std::string key = slurp(shard() / "cases" / ids()[0] / "key.txt");
   EXPECT_TRUE(contains(key, "\nfile summary.csv ")) << key;
-  EXPECT_TRUE(contains(key, "\nfile series.csv ")) << key;
+  EXPECT_TRUE(contains(key, "\nfile series.csv.gz ")) << key;
+  // The matrix keeps the series compressed only.
+  EXPECT_FALSE(fs::exists(shard() / "cases" / ids()[0] / "series.csv"));
   EXPECT_TRUE(contains(key, "binary=")) << key;
 }
 
