@@ -19,10 +19,7 @@ class BaumgarteFormulation final : public MechanicalFormulationBase<Model> {
   using Base = MechanicalFormulationBase<Model>;
 
  public:
-  using Base::nc;
-  using Base::nh;
-  using Base::nq;
-  using typename Base::VecQ;
+  CSTAB_MECHANICAL_SIZES(Base);
 
   BaumgarteFormulation(const Model& model, double alpha, double beta, double gamma)
       : Base(model), alpha_(alpha), beta_(beta), gamma_(gamma) {}

@@ -23,10 +23,7 @@ class BraunGoldfarbFormulation final : public MechanicalFormulationBase<Model> {
   using Base = MechanicalFormulationBase<Model>;
 
  public:
-  using Base::nc;
-  using Base::nh;
-  using Base::nq;
-  using typename Base::VecQ;
+  CSTAB_MECHANICAL_SIZES(Base);
 
   BraunGoldfarbFormulation(const Model& model, double dt, bool energy, double tol)
       : Base(model), dt_(dt), energy_(energy), tol_(tol) {

@@ -99,11 +99,7 @@ class GeneralizedAlphaFormulation final : public MechanicalFormulationBase<Model
   using Base = MechanicalFormulationBase<Model>;
 
  public:
-  using Base::nc;
-  using Base::nh;
-  using Base::nn;
-  using Base::nq;
-  using typename Base::VecQ;
+  CSTAB_MECHANICAL_SIZES(Base);
   static constexpr int nm = kIndex2 ? nh : 0;           // nu: the index-2 position correction
   static constexpr int nv = kIndex2 ? nc : nn;          // velocity-level rows in the step
   static constexpr int kA = 2 * nq, kVdot = 3 * nq, kLambda = 4 * nq, kNu = 4 * nq + nc;

@@ -41,10 +41,7 @@ class MechanicalDaeFormulation final : public MechanicalFormulationBase<Model>, 
   using Base = MechanicalFormulationBase<Model>;
 
  public:
-  using Base::nc;
-  using Base::nh;
-  using Base::nq;
-  using typename Base::VecQ;
+  CSTAB_MECHANICAL_SIZES(Base);
   static constexpr int nm = kGgl ? nh : 0;  // GGL multipliers of q' = v + J^T mu
   static constexpr int kDim = 2 * nq + nc + nm;
   static constexpr int kLambda = 2 * nq;    // offset of lambda in y

@@ -22,11 +22,7 @@ class IndexOneFormulation : public MechanicalFormulationBase<Model> {
   using Base = MechanicalFormulationBase<Model>;
 
  public:
-  using Base::nc;
-  using Base::nh;
-  using Base::nn;
-  using Base::nq;
-  using typename Base::VecQ;
+  CSTAB_MECHANICAL_SIZES(Base);
   using VecC = Vec<double, nc>;
 
   IndexOneFormulation(const Model& model, bool project, double tol, int max_iter)

@@ -252,6 +252,19 @@ void MechanicalTerms<Model>::nonholonomic_terms(const Model& model, double t, co
   }
 }
 
+// What a formulation class template names of its base (a
+// MechanicalFormulationBase or a class derived from it): members of a
+// dependent base are not found by plain lookup, so each formulation writes
+//   using Base = MechanicalFormulationBase<Model>;
+//  public:
+//   CSTAB_MECHANICAL_SIZES(Base);
+#define CSTAB_MECHANICAL_SIZES(Base) \
+  using Base::nc;                    \
+  using Base::nh;                    \
+  using Base::nn;                    \
+  using Base::nq;                    \
+  using typename Base::VecQ
+
 // Shared parts of every formulation on y = [q; v].
 template <class Model>
 class MechanicalFormulationBase : public Formulation {

@@ -110,10 +110,7 @@ class PesterevMechanicalFormulation final : public MechanicalFormulationBase<Mod
   using Base = MechanicalFormulationBase<Model>;
 
  public:
-  using Base::nc;
-  using Base::nh;
-  using Base::nq;
-  using typename Base::VecQ;
+  CSTAB_MECHANICAL_SIZES(Base);
 
   PesterevMechanicalFormulation(const Model& model, const Params& params) : Base(model) {
     for (int i = 0; i < nc; ++i) lambda_(i) = pesterev_detail::lambda_for(params, this->constraints_[i].name);

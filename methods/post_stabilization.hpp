@@ -35,11 +35,7 @@ class PostStabilizationFormulation final : public IndexOneFormulation<Model> {
   using Base = IndexOneFormulation<Model>;
 
  public:
-  using Base::nc;
-  using Base::nh;
-  using Base::nn;
-  using Base::nq;
-  using typename Base::VecQ;
+  CSTAB_MECHANICAL_SIZES(Base);
 
   PostStabilizationFormulation(const Model& model, bool refactor)
       : Base(model, false, 0.0, 0), refactor_(refactor) {}
