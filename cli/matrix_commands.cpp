@@ -81,11 +81,12 @@ methods = ["pesterev", "baumgarte", "none", "minimal"]
 integrators = ["cvode-bdf"]
 tol = [1e-6, 1e-9]
 
-# The generalized-alpha family: each method is its own implicit fixed-step
-# scheme (integrator "own"); three steps keep it to seconds per problem.
+# The generalized-alpha family and the augmented Lagrangian (ali3p): each
+# method is its own implicit fixed-step scheme (integrator "own"); three
+# steps keep it to seconds per problem.
 [[sweep]]
 name = "wp-own"
-methods = ["generalized-alpha", "hht", "generalized-alpha-i2"]
+methods = ["generalized-alpha", "hht", "generalized-alpha-i2", "ali3p"]
 integrators = ["own"]
 step = [1e-2, 3e-3, 1e-3]
 
@@ -156,13 +157,29 @@ int jobs_flag(const Args& args) {
   return int(jobs);
 }
 
-void finish(const std::string& dir, int jobs, bool plots) {
+ReportResult finish(const std::string& dir, int jobs, bool plots) {
   ReportOptions ro;
   ro.jobs = jobs;
   ro.plots = plots;
-  const ReportResult r = build_report(dir, ro, std::cerr);
+  ReportResult r = build_report(dir, ro, std::cerr);
   std::cout << "report: " << r.html << " (" << r.plots_drawn << " plots drawn, " << r.plots_reused
             << " unchanged)\n";
+  return r;
+}
+
+std::string one_decimal(double v) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.1f", v);
+  return text;
+}
+
+// After the report: the series no picture reads go (each case stays cached),
+// unless the case keeps them (keep_series, --keep-series).
+void drop_series(const std::string& out, const std::vector<MatrixCase>& cases, const ReportResult& report) {
+  const DroppedSeries d = drop_unused_series(out, cases, report.series_used);
+  if (d.cases)
+    std::cout << "matrix: kept the series the pictures read; dropped " << d.cases << " others ("
+              << one_decimal(double(d.bytes) / 1e6) << " MB; --keep-series or keep_series = true keeps them)\n";
 }
 
 // Outcomes over the whole folder, cached cases included: "3 ok, 1 diverged".
@@ -176,12 +193,6 @@ std::string folder_outcomes(const std::string& out) {
     text += (text.empty() ? "" : ", ") + std::to_string(n) + " " +
             (status == "invalid" ? std::string("not applicable") : status);
   return text.empty() ? "no results" : text;
-}
-
-std::string one_decimal(double v) {
-  char text[32];
-  std::snprintf(text, sizeof text, "%.1f", v);
-  return text;
 }
 
 // A run cut short: says so on stderr and returns the exit code; 0 if every
@@ -228,7 +239,9 @@ void declare_matrix(Args& a) {
   a.value("--shard", "K/N", "run only shard K of N (join the shard folders with `cstab merge`)")
       .value("--filter", "S", "run only the cases whose label contains S, or whose id or sweep name is S (see --list)")
       .flag("--force", "rerun cases even if their results are in DIR")
-      .flag("--no-report", "do not build the report after the run")
+      .flag("--no-report", "do not build the report after the run (every series is then kept)")
+      .flag("--keep-series", "keep every case's series (as matrix key keep_series = true); by default only "
+                             "the series the report's pictures read are kept")
       .flag("--list", "print the cases (index, id, sweep, label) and exit; no --out needed")
       .flag("--print-default", "print the embedded default matrix and exit");
 }
@@ -249,7 +262,9 @@ int cmd_matrix(const Args& args) {
   if (!filter.empty() && filtered.empty())
     throw UsageError("--filter '" + filter + "': matches none of the " + std::to_string(expansion.cases.size()) +
                      " cases (see --list)");
-  const auto cases = select_cases(filtered, "", shard_k, shard_n);
+  auto cases = select_cases(filtered, "", shard_k, shard_n);
+  if (args.has("--keep-series"))
+    for (auto& c : cases) c.keep_series = true;
 
   if (args.has("--list")) {
     for (const auto& n : expansion.notes) std::cout << "# note: " << n << "\n";
@@ -313,7 +328,7 @@ int cmd_matrix(const Args& args) {
     std::cout << "matrix: shard " << shard_k << "/" << shard_n << " done; join the shards with `cstab merge OUT "
               << "SHARD_DIR...`\n";
   else if (!args.has("--no-report"))
-    finish(out, jobs, true);
+    drop_series(out, cases, finish(out, jobs, true));
   return 0;
 }
 

@@ -42,6 +42,10 @@ struct ConformanceSettings {
   std::string integrator = "rk8pd";
   double tol = 1e-10;   // adaptive integrators: rtol = atol
   double step = 1e-3;   // fixed-step integrators (at most the problem's resolution_step)
+  // > 0: at least this many fixed steps over the horizon where the suite
+  // checks accuracy (a consistent start: energy drift and the reference);
+  // from an inconsistent start only the residuals are checked, at `step`.
+  double accuracy_steps = 0;
   std::vector<std::pair<std::string, std::string>> params = {};
   double time_scale_steps = 0;  // > 0: the method's time-scale gain is this many steps
   bool stabilizes = true;       // false: residuals drift by design (none)

@@ -1,6 +1,7 @@
 #include "io/number.hpp"
 
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <limits>
 
@@ -12,7 +13,14 @@ std::string number_cell(double v) { return std::isnan(v) ? std::string() : forma
 
 std::string count_cell(long n) { return n < 0 ? std::string() : std::to_string(n); }
 
-std::string log_plot_cell(double v) { return std::isfinite(v) && v > 0 ? format_exact(v) : "?"; }
+std::string plot_cell(double v) {
+  if (!std::isfinite(v)) return "?";
+  char text[32];
+  std::snprintf(text, sizeof text, "%.7g", v);
+  return text;
+}
+
+std::string log_plot_cell(double v) { return v > 0 ? plot_cell(v) : "?"; }
 
 bool try_parse_number(const std::string& text, double& value) {
   const char* begin = text.c_str();

@@ -13,8 +13,11 @@ std::string number_cell(double v);
 // A count cell: "" for a negative count (not recorded), else the integer.
 std::string count_cell(long n);
 
-// A value in a gnuplot data file for a log-scale axis: round-trip exact if
-// finite and > 0, else "?" (gnuplot's missing value).
+// A value in a gnuplot data file: 7 significant digits (a relative 1e-7,
+// far below a pixel of any picture, and about half the bytes of a
+// round-trip exact number), "?" (gnuplot's missing value) if not finite.
+std::string plot_cell(double v);
+// The same for a log-scale axis: "?" unless finite and > 0.
 std::string log_plot_cell(double v);
 
 // The number a whole cell holds ("1e-3", "0.001", "inf", "nan"); NaN if the

@@ -394,7 +394,7 @@ using Kind = MatrixValue::Kind;
 const std::vector<std::string>& known_keys() {
   static const std::vector<std::string> keys = {
       "name", "problems", "methods", "formulations", "integrators", "step", "tol", "rtol", "atol",
-      "t_end", "ref_time", "times", "sample_every", "blowup", "observe_every", "series", "repeats",
+      "t_end", "ref_time", "times", "sample_every", "blowup", "observe_every", "series", "keep_series", "repeats",
       "timeout", "repeat_if_under", "work_precision", "overlay", "optional", "perturb", "max_steps"};
   return keys;
 }
@@ -616,7 +616,7 @@ struct SweepPlan {
   double max_steps = kDefaultMaxSteps;
   const MatrixValue* max_steps_value = nullptr;  // for messages
   int observe_every = 1, repeats = 1;
-  bool series = true, work_precision = true, overlay = false;
+  bool series = true, keep_series = false, work_precision = true, overlay = false;
   std::vector<double> perturbs;
   std::vector<ParamChoice> params;
   size_t not_applicable = 0, wrong_integrator = 0, wrong_integrator_own = 0;
@@ -846,6 +846,7 @@ class Expander {
     p.observe_every = int(observe_every);
     p.repeats = int(repeats);
     p.series = set.boolean("series", true);
+    p.keep_series = set.boolean("keep_series", false);
     for (const auto* v : set.list("perturb", Kind::kNumber)) {
       if (!std::isfinite(v->number) || v->number < 0)
         throw MatrixError(v->where, "perturb: must be a number >= 0 (0: consistent start)");
@@ -1056,6 +1057,7 @@ class Expander {
     cfg.max_steps = p.max_steps;
     c.timeout = p.timeout;
     c.repeat_if_under = p.repeat_if_under;
+    c.keep_series = p.keep_series;
     c.config_text = canonical_text(cfg, p.repeats, p.timeout_text, p.repeat_if_under);
     CaseEntry& e = c.entry;
     e.id = hash_hex(c.config_text);

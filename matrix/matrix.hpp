@@ -28,6 +28,7 @@
 
 #include <functional>
 #include <iosfwd>
+#include <set>
 #include <string>
 #include <utility>
 #include <vector>
@@ -123,6 +124,10 @@ struct MatrixCase {
   RunConfig config;
   double timeout = kDefaultCaseTimeout;  // seconds, 0: none
   double repeat_if_under = 0;  // repeat only while a run takes less (seconds); 0: always
+  // Keep the series even where no picture reads it (key `keep_series`, flag
+  // --keep-series); not part of the configuration: a case whose series was
+  // dropped runs again when it is asked for.
+  bool keep_series = false;
   std::string config_text;   // canonical configuration; id = hash(config_text)
   double cost_estimate = 0;  // relative, for scheduling and shard balance
 };
@@ -190,6 +195,17 @@ struct MatrixRunStats {
 // `crashed` result. Rerunning resumes: finished cases are cached.
 MatrixRunStats run_matrix(const std::vector<MatrixCase>& cases, const MatrixRunOptions& options,
                           std::ostream& log, bool log_is_tty);
+
+// Drops the series of the finished cases in `cases` that neither keep them
+// (keep_series) nor are in `used` (the cases the report's pictures read).
+// Each stays cached: its key.txt no longer lists the series and says
+// `dropped series.csv.gz`. Returns how many were dropped and their bytes.
+struct DroppedSeries {
+  size_t cases = 0;
+  unsigned long long bytes = 0;
+};
+DroppedSeries drop_unused_series(const std::string& out_dir, const std::vector<MatrixCase>& cases,
+                                 const std::set<std::string>& used);
 // "SIGINT", "SIGTERM", "SIGHUP" (for messages about `interrupted_by`).
 std::string stop_signal_name(int sig);
 

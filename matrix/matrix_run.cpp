@@ -115,8 +115,9 @@ void write_result(const std::string& dir, const std::vector<Row>& rows, const st
 
 // Why the cached result in `dir` cannot be reused for `key` ("" if it can):
 // key.txt must hold this configuration and binary, then list every result
-// file with the size and hash it has now.
-std::string cache_problem(const std::string& dir, const std::string& key) {
+// file with the size and hash it has now. A series dropped by an earlier run
+// (`dropped NAME`, drop_unused_series) is fine unless `need_series`.
+std::string cache_problem(const std::string& dir, const std::string& key, bool need_series) {
   std::string text;
   try {
     text = read_text_file(dir + "/key.txt");
@@ -131,6 +132,10 @@ std::string cache_problem(const std::string& dir, const std::string& key) {
     std::istringstream words(line);
     std::string tag, name, hash;
     unsigned long long size = 0;
+    if (line.rfind("dropped ", 0) == 0) {
+      if (need_series) return "its series was dropped by an earlier run (keep_series asks for it)";
+      continue;
+    }
     if (!(words >> tag >> name >> size >> hash) || tag != "file") return "key.txt: malformed line '" + line + "'";
     listed.insert(name);
     const std::string path = dir + "/" + name;
@@ -293,7 +298,7 @@ std::vector<const MatrixCase*> uncached_cases(const std::vector<MatrixCase>& cas
   for (const auto& c : cases) {
     const std::string dir = case_folder(opt.out_dir, c.entry.id);
     if (!opt.force && !opt.binary_id.empty() && opt.binary_id != "unknown") {
-      const std::string why = cache_problem(dir, cache_key(c, opt.binary_id));
+      const std::string why = cache_problem(dir, cache_key(c, opt.binary_id), c.keep_series && c.config.write_series);
       if (why.empty()) {
         ++stats.cached;
         continue;
@@ -849,6 +854,40 @@ size_t merge_results(const std::string& out_dir, const std::vector<std::string>&
       << " copied) into " << out_dir << "\n";
   if (missing_results) log << "merge: warning: " << missing_results << " cases have no complete result\n";
   return uncovered + missing_results;
+}
+
+// Rewrites key.txt without the series' line (and with `dropped NAME`), then
+// removes the file: a crash between the two leaves a file key.txt does not
+// record, which cache_problem refuses, so the case runs again.
+DroppedSeries drop_unused_series(const std::string& out_dir, const std::vector<MatrixCase>& cases,
+                                 const std::set<std::string>& used) {
+  DroppedSeries dropped;
+  for (const auto& c : cases) {
+    if (c.keep_series || used.count(c.entry.id)) continue;
+    const std::string dir = case_folder(out_dir, c.entry.id);
+    for (const char* name : {"series.csv.gz", "series.csv"}) {
+      const std::string path = dir + "/" + name;
+      std::error_code ec;
+      const auto bytes = fs::file_size(path, ec);
+      if (ec) continue;
+      std::string key;
+      try {
+        key = read_text_file(dir + "/key.txt");
+      } catch (const std::exception&) {
+        continue;  // unfinished: the next run redoes it anyway
+      }
+      const std::string line = std::string("file ") + name + " ";
+      const size_t at = key.find("\n" + line);
+      if (at == std::string::npos) continue;  // not recorded: left for the cache check to refuse
+      const size_t end = key.find('\n', at + 1);
+      key.erase(at + 1, end == std::string::npos ? std::string::npos : end - at);
+      write_file_atomic(dir + "/key.txt", key + "dropped " + name + "\n");
+      fs::remove(path, ec);
+      ++dropped.cases;
+      dropped.bytes += bytes;
+    }
+  }
+  return dropped;
 }
 
 }  // namespace cstab

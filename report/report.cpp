@@ -254,7 +254,7 @@ std::string overlay_data(const std::string& dir, const std::vector<const CaseRes
       double res = cols.residuals.empty() ? kNaN : 0.0, drift = cols.drifts.empty() ? kNaN : 0.0;
       for (int col : cols.residuals) res = std::max(res, std::abs(cell(row, col)));
       for (int col : cols.drifts) drift = std::max(drift, std::abs(cell(row, col)));
-      out += row[0] + " " + log_plot_cell(res) + " " + log_plot_cell(drift) + "\n";
+      out += plot_cell(cell(row, 0)) + " " + log_plot_cell(res) + " " + log_plot_cell(drift) + "\n";
     }
   }
   return out;
@@ -285,11 +285,11 @@ std::string trajectory_data(const std::string& dir, const std::vector<const Case
     out += quoted_header(run_label(*c), names);
     lcs += " " + std::to_string(colour.at(c->entry->method));
     for (const auto& row : s.rows) {
-      out += row[0];
+      out += plot_cell(cell(row, 0));
       for (int col : shown) {
         const double v = cell(row, col);
         out += ' ';
-        out += std::isfinite(v) ? format_exact(v) : std::string("?");
+        out += plot_cell(v);
       }
       out += "\n";
     }
@@ -475,6 +475,7 @@ struct PlotSet {
   std::string plot_dir;
   std::vector<PlotJob> jobs;
   std::map<std::string, std::string> captions;
+  std::set<std::string> series_used;  // case ids whose series the pictures read
   // Writes plots/data/<name>.dat and queues the job; returns the name.
   std::string add(const std::string& name, const std::string& script, const std::string& data,
                   const std::string& extra_vars, const std::string& caption) {
@@ -529,9 +530,8 @@ WorkPrecisionData work_precision_data(const ProblemView& p, const ProblemStyle& 
       d.has_drift = d.has_drift || (std::isfinite(c->drift) && c->drift > 0);
     }
     for (const CaseResult* c : pts_of)
-      d.text += format_exact(c->wall_median) + " " + log_plot_cell(c->ref_error) + " " +
-                (std::isfinite(c->ref_scd) ? format_exact(c->ref_scd) : "?") + " " + log_plot_cell(c->max_residual) +
-                " " + log_plot_cell(c->drift) + " " + format_exact(case_size(*c)) + "\n";
+      d.text += plot_cell(c->wall_median) + " " + log_plot_cell(c->ref_error) + " " + plot_cell(c->ref_scd) + " " +
+                log_plot_cell(c->max_residual) + " " + log_plot_cell(c->drift) + " " + plot_cell(case_size(*c)) + "\n";
   }
   return d;
 }
@@ -565,6 +565,7 @@ void add_overlay_plot(PlotSet& plots, const std::string& dir, ProblemView& p, co
   std::string lcs;
   bool has_drift = false;
   const std::string text = overlay_data(dir, overlay, style.colour, lcs, has_drift);
+  for (const CaseResult* c : overlay) plots.series_used.insert(c->entry->id);
   if (text.empty()) return;
   std::string who;
   for (const CaseResult* c : overlay) who += (who.empty() ? "" : "; ") + run_label(*c);
@@ -585,6 +586,7 @@ void add_trajectory_plot(PlotSet& plots, const std::string& dir, ProblemView& p,
   std::vector<std::string> names;
   const auto trajectory = trajectory_runs(dir, p, overlay);
   const std::string text = trajectory_data(dir, trajectory, style.colour, lcs, names);
+  for (const CaseResult* c : trajectory) plots.series_used.insert(c->entry->id);
   if (text.empty()) return;
   std::string joined, who;
   for (const auto& n : names) joined += (joined.empty() ? "" : " ") + n;
@@ -917,6 +919,8 @@ ReportResult build_report(const std::string& dir, const ReportOptions& opt, std:
   const std::string scripts = opt.plot_scripts.empty() ? find_plot_scripts() : opt.plot_scripts;
   write_replot_script(plots, scripts);
   if (opt.plots) draw_plots(plots, scripts, opt.jobs, result);
+  result.series_used = plots.series_used;
+  result.series_used.insert(stress.series_used.begin(), stress.series_used.end());
   // report.html.
   const Provenance prov = parse_provenance(file_or_empty(dir + "/provenance.txt"));
   const Page page{dir, folder.cases, problems, stress, stress_plots, plots, prov, result.warnings};

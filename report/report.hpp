@@ -22,6 +22,7 @@
 #pragma once
 
 #include <iosfwd>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -37,6 +38,9 @@ struct ReportResult {
   std::string html;           // path of report.html
   size_t plots_drawn = 0, plots_reused = 0;
   std::vector<std::string> warnings;
+  // The cases whose series the pictures read (overlays, trajectories, long
+  // horizons): what `cstab matrix` keeps when it drops the other series.
+  std::set<std::string> series_used;
 };
 
 // Needs DIR/summary.csv (write_matrix_summary). A picture whose data and

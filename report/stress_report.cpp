@@ -135,7 +135,7 @@ void perturb_plots(const Cases& perturbed, StressSection& out) {
       lcs += ' ';
       lcs += std::to_string(m % 12 + 1);
       for (const CaseResult* c : pts)
-        data += format_exact(c->perturb) + " " + log_plot_cell(c->initial_residual) + " " + log_plot_cell(c->max_residual) +
+        data += plot_cell(c->perturb) + " " + log_plot_cell(c->initial_residual) + " " + log_plot_cell(c->max_residual) +
                 " " + (c->status == Status::kOk && c->recovered ? log_plot_cell(c->recovery_time) : "?") + "\n";
     }
     out.plots.push_back({"stress_perturb_" + problem, "stress_perturb.gp", data,
@@ -224,7 +224,7 @@ void add_long_series(LongPlots& plots, const std::string& dir, const CaseResult&
   for (size_t r = 0; r < series.rows.size(); ++r) {
     const double t = parse_number(series.get(r, "t")), e = std::abs(parse_number(series.get(r, "energy_drift")));
     if (std::isfinite(e)) running = std::max(running, e);
-    if (t > 0) data += format_exact(t) + " " + log_plot_cell(running) + "\n";
+    if (t > 0) data += plot_cell(t) + " " + log_plot_cell(running) + "\n";
   }
 }
 
@@ -245,6 +245,7 @@ void long_section(std::ostream& h, const ResultsFolder& folder, const Cases& lon
   for (const CaseResult* c : long_runs) {
     csv += long_row(h, *c, integrals);
     add_long_series(plots, folder.dir, *c);
+    out.series_used.insert(c->entry->id);
   }
   h << "</table>\n";
   write_file_atomic(folder.dir + "/stress_long.csv", csv);
@@ -314,7 +315,7 @@ void stiff_section(std::ostream& h, const std::string& dir, const Cases& stiff, 
     for (const CaseResult* c : rows) {
       const bool ok = c->status == Status::kOk;
       has_ref = has_ref || (ok && c->ref_error > 0);
-      data += format_exact(gain_of(*c->entry)) + " " + (ok ? log_plot_cell(first_wall(*c)) : "?") + " " +
+      data += plot_cell(gain_of(*c->entry)) + " " + (ok ? log_plot_cell(first_wall(*c)) : "?") + " " +
               (ok ? log_plot_cell(c->ref_error) : "?") + " " + (ok ? log_plot_cell(c->max_residual) : "?") + "\n";
     }
   }

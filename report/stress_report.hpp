@@ -19,6 +19,7 @@
 //     error, residual and the largest condition number per case.
 #pragma once
 
+#include <set>
 #include <string>
 #include <vector>
 
@@ -38,6 +39,7 @@ struct StressSection {
   bool empty = true;
   std::string html;              // tables (pictures are added by the report)
   std::vector<StressPlot> plots;
+  std::set<std::string> series_used;  // case ids whose series the pictures read
 };
 
 // From the cases of a results folder; writes DIR/stress_*.csv for what it finds.

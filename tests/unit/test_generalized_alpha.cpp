@@ -60,7 +60,10 @@ RunResult run_own(const std::string& problem, const std::string& method, double 
   cfg.t_end = t_end;
   cfg.ref_time = t_end;
   cfg.write_series = false;
-  cfg.params = {{"newton_tol", "1e-13"}, {"newton_iterations", "30"}};
+  if (method == "ali3p")
+    cfg.params = {{"tol", "1e-13"}, {"iterations", "200"}};
+  else
+    cfg.params = {{"newton_tol", "1e-13"}, {"newton_iterations", "30"}};
   return run_case(find_problem(problem), cfg, "");
 }
 
@@ -119,7 +122,7 @@ TEST_P(SecondOrder, SliderCrank) { expect_second_order({"slider-crank", 10, 4e-3
 TEST_P(SecondOrder, Andrews) { expect_second_order({"andrews", 0.03, 4e-5}, GetParam()); }
 
 INSTANTIATE_TEST_SUITE_P(GeneralizedAlpha, SecondOrder,
-                         ::testing::Values("generalized-alpha", "hht", "generalized-alpha-i2"),
+                         ::testing::Values("generalized-alpha", "hht", "generalized-alpha-i2", "ali3p"),
                          [](const ::testing::TestParamInfo<std::string>& i) {
                            std::string s = i.param;
                            for (char& c : s)
@@ -335,6 +338,10 @@ TEST(GeneralizedAlphaCli, BadParametersExitTwoWithOneLineAndNoOutput) {
       {"generalized-alpha", "own", "newton_iterations=0", "newton_iterations"},
       {"generalized-alpha", "own", "newton_iterations=2.5", "newton_iterations"},
       {"generalized-alpha", "own", "newton_tol=0", "newton_tol"},
+      {"ali3p", "own", "alpha=0", "alpha"},
+      {"ali3p", "own", "alpha=-1e9", "alpha"},
+      {"ali3p", "own", "iterations=0", "iterations"},
+      {"ali3p", "own", "tol=nan", "tol"},
       {"generalized-alpha", "rk4", "rho_inf=0.5", "--integrator"},  // wrong pairing
       {"baumgarte", "own", "", "--integrator"},
   };

@@ -402,6 +402,60 @@ TEST_F(Folder, ACachedCaseWhoseFilesChangedIsRerunSayingWhy) {
   EXPECT_TRUE(contains(o.out, "4 of 4 cases cached")) << o.out;
 }
 
+// ------------------------------------------------------------- series the pictures read
+
+size_t series_files(const fs::path& dir) {
+  size_t n = 0;
+  for (const auto& e : fs::recursive_directory_iterator(dir / "cases"))
+    if (e.path().filename() == "series.csv.gz") ++n;
+  return n;
+}
+
+TEST_F(Folder, TheMatrixKeepsOnlyTheSeriesThePicturesReadAndKeepSeriesBringsThemBack) {
+  const fs::path dir = copy("series_kept");
+  const auto id = ids();
+  ASSERT_EQ(id.size(), 4u);
+  ASSERT_EQ(series_files(dir), 4u);
+  const std::string full = cstab::testing::summary_without_timing(shard() / "summary.csv");
+  const std::string with_report = "matrix " + quote(dir_->dir() / "m.toml") + " --out " + quote(dir) + " --jobs 2";
+  // With the report: pesterev diverges at both steps and none of its runs
+  // is marked for the overlays, so no picture reads its series; of
+  // baumgarte's two runs, the pictures read the more accurate. The other
+  // three series go.
+  Outcome o = cstab_cmd(with_report);
+  ASSERT_EQ(o.code, 0) << o.out;
+  EXPECT_TRUE(contains(o.out, "4 of 4 cases cached")) << o.out;
+  EXPECT_TRUE(contains(o.out, "dropped 3 others")) << o.out;
+  EXPECT_EQ(series_files(dir), 1u);
+  size_t dropped = 0;
+  for (const auto& i : id) {
+    const std::string key = slurp(dir / "cases" / i / "key.txt");
+    const bool has = fs::exists(dir / "cases" / i / "series.csv.gz");
+    EXPECT_EQ(contains(key, "\nfile series.csv.gz "), has) << key;
+    EXPECT_EQ(contains(key, "\ndropped series.csv.gz\n"), !has) << key;
+    dropped += !has;
+  }
+  EXPECT_EQ(dropped, 3u);
+  // The report rebuilt from the folder picks the same runs.
+  const std::string trajectory = slurp(dir / "plots" / "data" / "wheel_trajectory.dat");
+  ASSERT_FALSE(trajectory.empty());
+  o = cstab_cmd("report " + quote(dir));
+  ASSERT_EQ(o.code, 0) << o.out;
+  EXPECT_EQ(slurp(dir / "plots" / "data" / "wheel_trajectory.dat"), trajectory);
+  // Dropped series are still cached results, and nothing more goes.
+  o = cstab_cmd(with_report);
+  ASSERT_EQ(o.code, 0) << o.out;
+  EXPECT_TRUE(contains(o.out, "4 of 4 cases cached")) << o.out;
+  EXPECT_FALSE(contains(o.out, "dropped")) << o.out;
+  // --keep-series reruns exactly the cases whose series went.
+  o = cstab_cmd(with_report + " --keep-series");
+  ASSERT_EQ(o.code, 0) << o.out;
+  EXPECT_TRUE(contains(o.out, "its series was dropped by an earlier run")) << o.out;
+  EXPECT_TRUE(contains(o.out, "3 run, 1 cached")) << o.out;
+  EXPECT_EQ(series_files(dir), 4u);
+  EXPECT_EQ(cstab::testing::summary_without_timing(dir / "summary.csv"), full);
+}
+
 TEST_F(Folder, KeyFilesRecordTheContentOfTheResult) {
   const std::string key = slurp(shard() / "cases" / ids()[0] / "key.txt");
   EXPECT_TRUE(contains(key, "\nfile summary.csv ")) << key;
