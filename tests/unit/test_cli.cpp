@@ -517,7 +517,7 @@ const std::map<std::string, std::set<std::string>> kCommandOptions = {
     {"stability",
      {"--problem", "--method", "--formulation", "--param", "--integrator", "--gain-param", "--steps", "--gains",
       "--t-end", "--blowup", "--bisect", "--max-steps", "--no-plot", "--out"}},
-    {"matrix", {"--out", "--jobs", "--shard", "--filter", "--force", "--no-report", "--list", "--print-default"}},
+    {"matrix", {"--out", "--jobs", "--shard", "--filter", "--force", "--no-report", "--keep-series", "--list", "--print-default"}},
     {"merge", {"--jobs", "--no-report"}},
     {"report", {"--jobs", "--no-plots"}},
     {"gate",
