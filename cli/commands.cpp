@@ -7,9 +7,7 @@
 #include <sstream>
 
 #include "cli/args.hpp"
-#include "cli/gate_command.hpp"
 #include "cli/matrix_commands.hpp"
-#include "cli/stability_command.hpp"
 #include "core/format.hpp"
 #include "harness/integrator.hpp"
 #include "harness/run.hpp"

@@ -25,4 +25,15 @@ std::string command_help(const std::string& command);
 // --problem, --method, --formulation, --param, --integrator, --t-end.
 void declare_case_options(Args& args);
 
+// Commands in files of their own: declare_X declares the options of
+// `cstab X`, cmd_X runs it.
+// cstab gate (gate_command.cpp): checks a matrix results folder against a
+// thresholds file.
+void declare_gate(Args& args);
+int cmd_gate(const Args& args);
+// cstab stability (stability_command.cpp): step x gain maps and measured
+// stability boundaries.
+void declare_stability(Args& args);
+int cmd_stability(const Args& args);
+
 }  // namespace cstab::cli

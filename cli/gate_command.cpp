@@ -6,7 +6,7 @@
 // cstab gate --init FILE [--factor F] [--time-factor T] [--recovery-factor R] DIR
 //   writes a new thresholds file with every completed case of DIR.
 // (declare_gate below is what parses them and prints `cstab gate --help`.)
-#include "cli/gate_command.hpp"
+#include "cli/commands.hpp"
 
 #include <filesystem>
 #include <memory>

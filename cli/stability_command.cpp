@@ -2,7 +2,6 @@
 // Writes DIR/stability.csv (the h x gain map), DIR/boundary.csv (per step:
 // the measured boundary in h*rate and the integrator's theoretical real
 // stability interval) and, if gnuplot is present, DIR/stability.png/.svg.
-#include "cli/stability_command.hpp"
 
 #include <cmath>
 #include <cstdlib>

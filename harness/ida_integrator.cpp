@@ -19,84 +19,34 @@
 #include <sunmatrix/sunmatrix_dense.h>
 
 #include <cmath>
-#include <cstdlib>
 #include <memory>
-#include <type_traits>
 
 #include "core/format.hpp"
-#include "harness/integrator.hpp"
 #include "core/params.hpp"
+#include "harness/integrator.hpp"
+#include "harness/sundials_common.hpp"
 
 namespace cstab {
 
 namespace {
 
-static_assert(std::is_same_v<realtype, double>, "SUNDIALS must be built in double precision");
+constexpr SundialsIntegrator::Names kIdaNames = {
+    "ida", "IDA", "residual", "IDASetStopTime", "IDASolve", "IDAReInit", SundialsPackage::kIda, IDAFree};
 
-// IDA return codes in words.
-std::string ida_flag_words(int flag) {
-  switch (flag) {
-    case IDA_TOO_MUCH_WORK: return "too much work (internal step limit reached)";
-    case IDA_TOO_MUCH_ACC: return "tolerances too tight for machine precision";
-    case IDA_ERR_FAIL: return "repeated error-test failures (step size collapsed)";
-    case IDA_CONV_FAIL: return "Newton iteration failed to converge repeatedly (step size collapsed)";
-    case IDA_LINIT_FAIL: return "linear solver initialisation failed";
-    case IDA_LSETUP_FAIL: return "linear solver setup failed (singular iteration matrix)";
-    case IDA_LSOLVE_FAIL: return "linear solve failed";
-    case IDA_RES_FAIL: return "residual evaluation failed unrecoverably";
-    case IDA_REP_RES_ERR: return "repeated recoverable residual failures";
-    case IDA_CONSTR_FAIL: return "inequality constraints could not be met";
-    case IDA_FIRST_RES_FAIL: return "residual failed at the first call of the initial-value calculation";
-    case IDA_LINESEARCH_FAIL: return "line search failed in the initial-value calculation";
-    case IDA_NO_RECOVERY: return "initial-value calculation could not recover from a residual or linear-solver failure";
-    case IDA_NLS_INIT_FAIL: return "nonlinear solver initialisation failed";
-    case IDA_NLS_SETUP_FAIL: return "nonlinear solver setup failed";
-    case IDA_NLS_FAIL: return "nonlinear solver failed";
-    case IDA_MEM_FAIL: return "out of memory";
-    case IDA_ILL_INPUT: return "illegal input";
-    case IDA_BAD_EWT: return "an error weight became non-positive";
-    case IDA_BAD_T: return "time outside the last step";
-    default: {
-      char* name = IDAGetReturnFlagName(flag);  // malloc'd by SUNDIALS
-      std::string words = name ? name : "unknown return code " + std::to_string(flag);
-      std::free(name);
-      return words;
-    }
-  }
-}
-
-class IdaIntegrator final : public Integrator {
+class IdaIntegrator final : public SundialsIntegrator {
  public:
-  explicit IdaIntegrator(const StepSettings& settings) : settings_(settings) {
-    if (SUNContext_Create(nullptr, &ctx_) != 0) throw std::runtime_error("ida: SUNContext_Create failed");
-  }
-  ~IdaIntegrator() override {
-    release();
-    SUNContext_Free(&ctx_);
-  }
-  IdaIntegrator(const IdaIntegrator&) = delete;
-  IdaIntegrator& operator=(const IdaIntegrator&) = delete;
+  explicit IdaIntegrator(const StepSettings& settings) : SundialsIntegrator(kIdaNames, settings) {}
+  ~IdaIntegrator() override { release(); }  // the solver memory before the vectors below
 
   void start(OdeSystem& sys, double t0, const double* y0) override {
-    release();
-    sys_ = &sys;
-    n_ = sys.dimension();
-    t_ = t0;
-    h_used_ = 0;
-    steps_ = rejected_ = rhs_evals_ = 0;
-    failure_.clear();
-    solver_message_.clear();
-    residual_failure_.clear();
+    begin_start(sys, t0, y0);
     need_initial_condition_ = true;
-    y_.assign(y0, y0 + n_);
     dae_ = dynamic_cast<DaeSystem*>(&sys);
     if (!dae_) {
-      ready_ = false;
       failure_ = "ida: the formulation is not a DAE F(t, y, y') = 0 (use a DAE method: ida-index1, ida-ggl)";
       return;
     }
     if (dae_->dae_dimension() != n_) {
-      ready_ = false;
       failure_ = "ida: DAE dimension " + std::to_string(dae_->dae_dimension()) +
                  " differs from the formulation's dimension " + std::to_string(n_);
       return;
@@ -108,53 +58,10 @@ class IdaIntegrator final : public Integrator {
     ready_ = setup(t0);
   }
 
-  StepOutcome step(double t_limit) override {
-    if (!ready_) {
-      if (failure_.empty()) failure_ = "ida: not started";
-      return StepOutcome::kFailed;
-    }
-    residual_failure_.clear();
-    solver_message_.clear();
-    if (need_initial_condition_) {
-      if (!make_consistent(t_limit)) return StepOutcome::kFailed;
-      need_initial_condition_ = false;
-      estimate_first_step(t_limit);
-    }
-    int flag = IDASetStopTime(mem_, t_limit);
-    if (flag < 0) return fail(flag, "IDASetStopTime");
-    double t_returned = t_;
-    flag = IDASolve(mem_, t_limit, &t_returned, yy_, ypp_, IDA_ONE_STEP);
-    refresh_counts();
-    if (flag < 0) return fail(flag, "IDASolve");
-    t_ = t_returned;
-    IDAGetLastStep(mem_, &h_used_);
-    return StepOutcome::kOk;
-  }
-
-  bool state_at(double t_target, double* out) override {
-    if (t_target != t_) return false;  // IDA lands exactly on every limit
-    std::copy(y_.begin(), y_.end(), out);
-    return true;
-  }
-
-  bool notify_modified() override {
-    // y changed in place (a post-step hook): restart from it at order 1
-    // and make the algebraic components consistent again.
-    if (!ready_) return false;
-    const int flag = IDAReInit(mem_, t_, yy_, ypp_);
-    if (flag < 0) {
-      fail(flag, "IDAReInit");
-      return false;
-    }
-    need_initial_condition_ = true;
-    return true;
-  }
-
   std::vector<std::pair<std::string, std::string>> statistics() const override {
     long steps = 0, res_evals = 0, jac_evals = 0, jac_res_evals = 0, nonlin_iters = 0, err_test_fails = 0,
          nonlin_conv_fails = 0;
     int last_order = 0;
-    double last_step = 0;
     if (mem_) {
       IDAGetNumSteps(mem_, &steps);
       IDAGetNumResEvals(mem_, &res_evals);
@@ -164,7 +71,6 @@ class IdaIntegrator final : public Integrator {
       IDAGetNumErrTestFails(mem_, &err_test_fails);
       IDAGetNumNonlinSolvConvFails(mem_, &nonlin_conv_fails);
       IDAGetLastOrder(mem_, &last_order);
-      IDAGetLastStep(mem_, &last_step);
     }
     return {{"ida_steps", std::to_string(steps)},
             {"ida_res_evals", std::to_string(res_evals)},
@@ -174,29 +80,61 @@ class IdaIntegrator final : public Integrator {
             {"ida_err_test_fails", std::to_string(err_test_fails)},
             {"ida_nonlin_conv_fails", std::to_string(nonlin_conv_fails)},
             {"ida_last_order", std::to_string(last_order)},
-            {"ida_last_step", format_exact(last_step)}};
+            {"ida_last_step", format_exact(last_step())}};
   }
 
  private:
+  // Before the first step after a (re)start: consistent initial values.
+  bool before_step(double t_limit) override {
+    solver_message_.clear();
+    if (!need_initial_condition_) return true;
+    if (!make_consistent(t_limit)) return false;
+    need_initial_condition_ = false;
+    estimate_first_step(t_limit);
+    return true;
+  }
+  int set_stop_time(double t_limit) override { return IDASetStopTime(mem_, t_limit); }
+  int solve(double t_limit, double* t_returned) override {
+    return IDASolve(mem_, t_limit, t_returned, yy_, ypp_, IDA_ONE_STEP);
+  }
+  double last_step() const override {
+    double h = 0;
+    if (mem_) IDAGetLastStep(mem_, &h);
+    return h;
+  }
+  void refresh_counts() override {
+    long steps = 0, err_test_fails = 0, solve_fails = 0;
+    IDAGetNumSteps(mem_, &steps);
+    IDAGetNumErrTestFails(mem_, &err_test_fails);
+    IDAGetNumStepSolveFails(mem_, &solve_fails);
+    steps_ = steps;
+    rejected_ = err_test_fails + solve_fails;
+  }
+  // At order 1; the algebraic components are made consistent again before
+  // the next step.
+  int restart() override {
+    const int flag = IDAReInit(mem_, t_, yy_, ypp_);
+    if (flag >= 0) need_initial_condition_ = true;
+    return flag;
+  }
+
   bool setup(double t0) {
     // yy_/ypp_ wrap y_/yp_: IDA writes the solution straight into y().
-    yy_ = N_VMake_Serial(n_, y_.data(), ctx_);
-    ypp_ = N_VMake_Serial(n_, yp_.data(), ctx_);
-    id_ = N_VNew_Serial(n_, ctx_);
-    matrix_ = SUNDenseMatrix(n_, n_, ctx_);
-    if (!yy_ || !ypp_ || !id_ || !matrix_) return setup_failed("out of memory");
-    linear_solver_ = SUNLinSol_Dense(yy_, matrix_, ctx_);
+    yy_.reset(wrap(y_.data()));
+    ypp_.reset(wrap(yp_.data()));
+    id_.reset(N_VNew_Serial(n_, ctx_));
+    if (!yy_ || !ypp_ || !id_ || !make_dense_linear_solver()) return setup_failed("out of memory");
     mem_ = IDACreate(ctx_);
-    if (!linear_solver_ || !mem_) return setup_failed("out of memory");
+    if (!mem_) return setup_failed("out of memory");
     dae_->component_ids(N_VGetArrayPointer(id_));
-    IDASetErrHandlerFn(mem_, &IdaIntegrator::error_handler, this);
+    IDASetErrHandlerFn(mem_, &SundialsIntegrator::error_handler, user_data());
     int flag = IDAInit(mem_, &IdaIntegrator::residual_callback, t0, yy_, ypp_);
-    if (flag == IDA_SUCCESS) flag = IDASetUserData(mem_, this);
+    if (flag == IDA_SUCCESS) flag = IDASetUserData(mem_, user_data());
     if (flag == IDA_SUCCESS) flag = IDAWFtolerances(mem_, &IdaIntegrator::error_weights);
     if (flag == IDA_SUCCESS) flag = IDASetId(mem_, id_);
     if (flag == IDA_SUCCESS) flag = IDASetSuppressAlg(mem_, SUNTRUE);
     if (flag == IDA_SUCCESS) flag = IDASetLinearSolver(mem_, linear_solver_, matrix_);
-    if (flag != IDA_SUCCESS) return setup_failed(ida_flag_words(flag));
+    if (flag != IDA_SUCCESS) return setup_failed(flag);
     return true;
   }
 
@@ -253,50 +191,12 @@ class IdaIntegrator final : public Integrator {
     return true;
   }
 
-  bool setup_failed(const std::string& why) {
-    failure_ = "ida: setup failed: " + why + (solver_message_.empty() ? "" : " (" + solver_message_ + ")");
-    return false;
-  }
-
-  void release() {
-    if (mem_) IDAFree(&mem_);
-    if (linear_solver_) SUNLinSolFree(linear_solver_);
-    if (matrix_) SUNMatDestroy(matrix_);
-    for (N_Vector* v : {&yy_, &ypp_, &id_}) {
-      if (*v) N_VDestroy(*v);
-      *v = nullptr;
-    }
-    mem_ = nullptr;
-    linear_solver_ = nullptr;
-    matrix_ = nullptr;
-    dae_ = nullptr;
-    ready_ = false;
-  }
-
-  void refresh_counts() {
-    long steps = 0, err_test_fails = 0, solve_fails = 0;
-    IDAGetNumSteps(mem_, &steps);
-    IDAGetNumErrTestFails(mem_, &err_test_fails);
-    IDAGetNumStepSolveFails(mem_, &solve_fails);
-    steps_ = steps;
-    rejected_ = err_test_fails + solve_fails;
-  }
-
-  StepOutcome fail(int flag, const char* where) {
-    failure_ = "IDA (" + std::string(where) + "): " + ida_flag_words(flag);
-    if (!residual_failure_.empty()) failure_ += "; residual: " + residual_failure_;
-    if (!solver_message_.empty()) failure_ += " [" + solver_message_ + "]";
-    return StepOutcome::kFailed;
-  }
-
   static int residual_callback(realtype t, N_Vector y, N_Vector yp, N_Vector r, void* user_data) {
-    auto* self = static_cast<IdaIntegrator*>(user_data);
+    auto* self = from_user_data<IdaIntegrator>(user_data);
     ++self->rhs_evals_;
     if (self->dae_->residual(t, N_VGetArrayPointer(y), N_VGetArrayPointer(yp), N_VGetArrayPointer(r)))
       return 0;
-    self->residual_failure_ = self->sys_->failure_reason();
-    if (self->residual_failure_.empty()) self->residual_failure_ = "residual failed at t = " + format_short(t);
-    return 1;  // recoverable: IDA retries with a smaller step
+    return self->callback_failed(t);
   }
 
   // Error weights 1 / (rtol |y_i| + atol) for the differential components.
@@ -311,7 +211,7 @@ class IdaIntegrator final : public Integrator {
   // Before the first step (h = 0) IDA's own initial-step formula stands in
   // for h; while IDACalcIC computes them they keep the plain weight.
   static int error_weights(N_Vector y, N_Vector ewt, void* user_data) {
-    auto* self = static_cast<IdaIntegrator*>(user_data);
+    auto* self = from_user_data<IdaIntegrator>(user_data);
     double h = 0;
     IDAGetCurrentStep(self->mem_, &h);
     if (h == 0) h = self->first_step_estimate_;
@@ -326,26 +226,12 @@ class IdaIntegrator final : public Integrator {
     return 0;
   }
 
-  // IDA's own message for the last error, kept for failure_reason() instead
-  // of being printed to stderr.
-  static void error_handler(int, const char*, const char* function, char* msg, void* user_data) {
-    auto* self = static_cast<IdaIntegrator*>(user_data);
-    self->solver_message_ = std::string(function) + ": " + msg;
-  }
-
-  StepSettings settings_;
-  SUNContext ctx_ = nullptr;
-  void* mem_ = nullptr;
-  N_Vector yy_ = nullptr, ypp_ = nullptr, id_ = nullptr;
-  SUNMatrix matrix_ = nullptr;
-  SUNLinearSolver linear_solver_ = nullptr;
+  SundialsVector ypp_, id_;  // y' (wraps yp_), the differential (1) / algebraic (0) components
   DaeSystem* dae_ = nullptr;
   std::vector<double> yp_, scratch_;
-  bool ready_ = false;
   bool need_initial_condition_ = true;
   bool in_calc_ic_ = false;
   double first_step_estimate_ = 1.0;  // stands in for h before the first step
-  std::string residual_failure_, solver_message_;
 };
 
 }  // namespace

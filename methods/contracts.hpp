@@ -215,36 +215,23 @@ inline constexpr bool info_ok = requires(const P& p) {
   { p.info() } -> std::convertible_to<ProblemInfo>;
 };
 
-// The model accessors: absent, or callable on a const problem and giving a
-// model of the right kind.
-template <class P>
-inline constexpr bool mechanical_const = requires(const P& p) { p.mechanical(); };
-template <class P>
-inline constexpr bool state_space_const = requires(const P& p) { p.state_space(); };
-template <class P>
-inline constexpr bool minimal_const = requires(const P& p) { p.minimal(); };
-
-template <class P>
-consteval bool mechanical_accessor_ok() {
-  if constexpr (mechanical_const<P>)
-    return MechanicalModel<std::decay_t<decltype(std::declval<const P&>().mechanical())>>;
-  else
-    return !names_mechanical<P>;
-}
-template <class P>
-consteval bool state_space_accessor_ok() {
-  if constexpr (state_space_const<P>)
-    return AffineModel<std::decay_t<decltype(std::declval<const P&>().state_space())>>;
-  else
-    return !names_state_space<P>;
-}
-template <class P>
-consteval bool minimal_accessor_ok() {
-  if constexpr (minimal_const<P>)
-    return MinimalModel<std::decay_t<decltype(std::declval<const P&>().minimal())>>;
-  else
-    return !names_minimal<P>;
-}
+// The model accessors: absent (and nothing of that name), or callable on a
+// const problem and giving a model of the right kind: <name>_const<P>,
+// <name>_accessor_ok<P>().
+#define CSTAB_CONTRACT_MODEL_ACCESSOR(name, ModelConcept)                             \
+  template <class P>                                                                 \
+  inline constexpr bool name##_const = requires(const P& p) { p.name(); };           \
+  template <class P>                                                                 \
+  consteval bool name##_accessor_ok() {                                              \
+    if constexpr (name##_const<P>)                                                   \
+      return ModelConcept<std::decay_t<decltype(std::declval<const P&>().name())>>; \
+    else                                                                             \
+      return !names_##name<P>;                                                       \
+  }
+CSTAB_CONTRACT_MODEL_ACCESSOR(mechanical, MechanicalModel)
+CSTAB_CONTRACT_MODEL_ACCESSOR(state_space, AffineModel)
+CSTAB_CONTRACT_MODEL_ACCESSOR(minimal, MinimalModel)
+#undef CSTAB_CONTRACT_MODEL_ACCESSOR
 
 // The optional observables, with the exact calls ProblemAdapter makes.
 template <class P>

@@ -312,68 +312,64 @@ inline AlphaSettings alpha_settings(const AlphaCoefficients& c, const Params& pa
   return s;
 }
 
-// Settings of the conformance suite: the own scheme at a step where its
-// O(h^2) error is below the suite's 1e-5 against the references. Second
-// order: at least 80000 steps over the horizon where accuracy is checked
-// (1e-5 against andrews' reference at 0.03 s; hht's energy drift on
-// wheel-sharp, 1.3e-5 at h = 5e-5, 3.2e-6 at 2.5e-5, measured).
-inline ConformanceSettings alpha_conformance() {
-  return {.integrator = "own", .step = 1e-4, .accuracy_steps = 80000};
-}
-
-struct GeneralizedAlphaMethod : MechanicalMethod<GeneralizedAlphaMethod> {
-  static constexpr const char* kName = "generalized-alpha";
+// What the three methods share: self-stepping, for --integrator own, full
+// rank; their parameters are Derived::scheme_param() and the Newton ones,
+// and Derived::coefficients(params) sets the scheme.
+template <class Derived, bool kIndex2>
+struct AlphaMethod : MechanicalMethod<Derived> {
   static constexpr MethodKind kKind = MethodKind::kSelfStepping;
+  // Settings of the conformance suite: the own scheme at a step where its
+  // O(h^2) error is below the suite's 1e-5 against the references. Second
+  // order: at least 80000 steps over the horizon where accuracy is checked
+  // (1e-5 against andrews' reference at 0.03 s; hht's energy drift on
+  // wheel-sharp, 1.3e-5 at h = 5e-5, 3.2e-6 at 2.5e-5, measured).
+  static ConformanceSettings conformance() { return {.integrator = "own", .step = 1e-4, .accuracy_steps = 80000}; }
+  static std::vector<ParamSpec> generic_params() {
+    std::vector<ParamSpec> p = {Derived::scheme_param()};
+    for (auto& s : alpha_newton_params()) p.push_back(s);
+    return p;
+  }
+  template <class Model>
+  static std::unique_ptr<Formulation> make_model(const Model& model, const Params& params) {
+    require_full_rank(model, Derived::kName);
+    return std::make_unique<GeneralizedAlphaFormulation<Model, kIndex2>>(
+        model, Derived::kName, alpha_settings(Derived::coefficients(params), params));
+  }
+};
+
+struct GeneralizedAlphaMethod : AlphaMethod<GeneralizedAlphaMethod, false> {
+  static constexpr const char* kName = "generalized-alpha";
   static constexpr const char* kDescription =
       "index-3 generalized-alpha (Arnold & Bruls 2007) for --integrator own: Newton on (q, lambda), scaled "
       "iteration matrix; non-holonomic rows at velocity level (full rank)";
-  static ConformanceSettings conformance() { return alpha_conformance(); }
-  static std::vector<ParamSpec> generic_params() {
-    std::vector<ParamSpec> p = {ranged_param("rho_inf", 0.9, 0, 1, "spectral radius at infinite frequency (1: no damping)")};
-    for (auto& s : alpha_newton_params()) p.push_back(s);
-    return p;
+  static ParamSpec scheme_param() {
+    return ranged_param("rho_inf", 0.9, 0, 1, "spectral radius at infinite frequency (1: no damping)");
   }
-  template <class Model>
-  static std::unique_ptr<Formulation> make_model(const Model& model, const Params& params) {
-    require_full_rank(model, kName);
-    return std::make_unique<GeneralizedAlphaFormulation<Model, false>>(
-        model, kName, alpha_settings(AlphaCoefficients::from_rho_inf(params.get("rho_inf")), params));
+  static AlphaCoefficients coefficients(const Params& params) {
+    return AlphaCoefficients::from_rho_inf(params.get("rho_inf"));
   }
 };
 
-struct HhtMethod : MechanicalMethod<HhtMethod> {
+struct HhtMethod : AlphaMethod<HhtMethod, false> {
   static constexpr const char* kName = "hht";
-  static constexpr MethodKind kKind = MethodKind::kSelfStepping;
   static constexpr const char* kDescription =
       "index-3 HHT-alpha in the generalized-alpha framework (alpha_m = 0) for --integrator own (full rank)";
-  static ConformanceSettings conformance() { return alpha_conformance(); }
-  static std::vector<ParamSpec> generic_params() {
-    std::vector<ParamSpec> p = {ranged_param("alpha", -0.2, -1.0 / 3.0, 0, "HHT alpha (0: trapezoidal rule; rho_inf = (1 + alpha)/(1 - alpha))")};
-    for (auto& s : alpha_newton_params()) p.push_back(s);
-    return p;
+  static ParamSpec scheme_param() {
+    return ranged_param("alpha", -0.2, -1.0 / 3.0, 0, "HHT alpha (0: trapezoidal rule; rho_inf = (1 + alpha)/(1 - alpha))");
   }
-  template <class Model>
-  static std::unique_ptr<Formulation> make_model(const Model& model, const Params& params) {
-    require_full_rank(model, kName);
-    return std::make_unique<GeneralizedAlphaFormulation<Model, false>>(
-        model, kName, alpha_settings(AlphaCoefficients::from_hht_alpha(params.get("alpha")), params));
+  static AlphaCoefficients coefficients(const Params& params) {
+    return AlphaCoefficients::from_hht_alpha(params.get("alpha"));
   }
 };
 
-struct GeneralizedAlphaIndex2Method : MechanicalMethod<GeneralizedAlphaIndex2Method> {
+struct GeneralizedAlphaIndex2Method : AlphaMethod<GeneralizedAlphaIndex2Method, true> {
   static constexpr const char* kName = "generalized-alpha-i2";
-  static constexpr MethodKind kKind = MethodKind::kSelfStepping;
   static constexpr const char* kDescription =
       "stabilized index-2 generalized-alpha (Arnold, Cardona & Bruls 2016) for --integrator own: position and "
       "velocity constraints both to Newton tolerance (full rank)";
-  static ConformanceSettings conformance() { return alpha_conformance(); }
-  static std::vector<ParamSpec> generic_params() { return GeneralizedAlphaMethod::generic_params(); }
-  template <class Model>
-  static std::unique_ptr<Formulation> make_model(const Model& model, const Params& params) {
-    require_full_rank(model, kName);
-    return std::make_unique<GeneralizedAlphaFormulation<Model, true>>(
-        model, kName, alpha_settings(AlphaCoefficients::from_rho_inf(params.get("rho_inf")), params));
-  }
+  // The index-3 method's parameter and coefficients (rho_inf).
+  static ParamSpec scheme_param() { return GeneralizedAlphaMethod::scheme_param(); }
+  static AlphaCoefficients coefficients(const Params& params) { return GeneralizedAlphaMethod::coefficients(params); }
 };
 
 }  // namespace cstab

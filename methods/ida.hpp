@@ -209,34 +209,32 @@ class MechanicalDaeFormulation final : public MechanicalFormulationBase<Model>, 
   MechanicalTerms<Model> terms_;
 };
 
-struct IdaIndexOneMethod : MechanicalMethod<IdaIndexOneMethod> {
-  static constexpr const char* kName = "ida-index1";
+// What the two DAE methods share: for --integrator ida, full rank, no
+// parameters; kGgl picks the formulation (index 1 or stabilized index 2).
+template <class Derived, bool kGgl>
+struct IdaMethod : MechanicalMethod<Derived> {
   static constexpr bool kIsDae = true;  // F(t, y, y') = 0: needs a DAE integrator
   static ConformanceSettings conformance() { return {.integrator = "ida", .tol = 1e-9}; }
-  static constexpr const char* kDescription =
-      "DAE for --integrator ida: [q, v, lambda], constraints at acceleration level (index 1); drifts at "
-      "the tolerance (full rank)";
   static std::vector<ParamSpec> generic_params() { return {}; }
   template <class Model>
   static std::unique_ptr<Formulation> make_model(const Model& model, const Params&) {
-    require_full_rank(model, kName);
-    return std::make_unique<MechanicalDaeFormulation<Model, false>>(model, kName);
+    require_full_rank(model, Derived::kName);
+    return std::make_unique<MechanicalDaeFormulation<Model, kGgl>>(model, Derived::kName);
   }
 };
 
-struct IdaGglMethod : MechanicalMethod<IdaGglMethod> {
+struct IdaIndexOneMethod : IdaMethod<IdaIndexOneMethod, false> {
+  static constexpr const char* kName = "ida-index1";
+  static constexpr const char* kDescription =
+      "DAE for --integrator ida: [q, v, lambda], constraints at acceleration level (index 1); drifts at "
+      "the tolerance (full rank)";
+};
+
+struct IdaGglMethod : IdaMethod<IdaGglMethod, true> {
   static constexpr const char* kName = "ida-ggl";
-  static constexpr bool kIsDae = true;
-  static ConformanceSettings conformance() { return {.integrator = "ida", .tol = 1e-9}; }
   static constexpr const char* kDescription =
       "DAE for --integrator ida: stabilized index-2 Gear-Gupta-Leimkuhler [q, v, lambda, mu], position and "
       "velocity constraints enforced (full rank)";
-  static std::vector<ParamSpec> generic_params() { return {}; }
-  template <class Model>
-  static std::unique_ptr<Formulation> make_model(const Model& model, const Params&) {
-    require_full_rank(model, kName);
-    return std::make_unique<MechanicalDaeFormulation<Model, true>>(model, kName);
-  }
 };
 
 }  // namespace cstab

@@ -68,11 +68,7 @@ struct MinimalMethod {
   template <class P>
   static std::string why_not(const P&) {
     static_assert(contracts::check_problem<P>());
-    if constexpr (contracts::HasMinimal<P>) {
-      return {};
-    } else {
-      return "problem has no minimal-coordinate formulation";
-    }
+    return contracts::HasMinimal<P> ? "" : "problem has no minimal-coordinate formulation";
   }
   template <class P>
   static std::vector<ParamSpec> params(const P& p, const std::string& formulation) {

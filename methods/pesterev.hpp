@@ -179,11 +179,9 @@ struct PesterevMethod {
   template <class P>
   static std::string why_not(const P&) {
     static_assert(contracts::check_problem<P>());
-    if constexpr (contracts::HasStateSpace<P> || contracts::HasMechanical<P>) {
-      return {};
-    } else {
-      return "problem has neither an affine (state-space) nor a mechanical model";
-    }
+    return (contracts::HasStateSpace<P> || contracts::HasMechanical<P>)
+               ? ""
+               : "problem has neither an affine (state-space) nor a mechanical model";
   }
 
   template <class P>

@@ -1,5 +1,6 @@
 #include "problems/biped/biped.hpp"
 
+#include <array>
 #include <complex>
 #include <stdexcept>
 
@@ -62,22 +63,18 @@ BipedMechanical::Chain BipedMechanical::body_com(int k) const {
   }
 }
 
+namespace {
+// The segment body k is (bodies 1-3: leg 1, 4-6: leg 2): 0 the HAT, 1 a
+// thigh, 2 a shank, 3 a foot.
+int segment_of(int k) { return k == 0 ? 0 : (k - 1) % 3 + 1; }
+}  // namespace
+
 double BipedMechanical::body_mass(int k) const {
-  switch (k) {
-    case 0: return p_.m_hat;
-    case 1: case 4: return p_.m_thigh;
-    case 2: case 5: return p_.m_shank;
-    default: return p_.m_foot;
-  }
+  return std::array<double, 4>{p_.m_hat, p_.m_thigh, p_.m_shank, p_.m_foot}[segment_of(k)];
 }
 
 double BipedMechanical::body_inertia(int k) const {
-  switch (k) {
-    case 0: return p_.i_hat;
-    case 1: case 4: return p_.i_thigh;
-    case 2: case 5: return p_.i_shank;
-    default: return p_.i_foot;
-  }
+  return std::array<double, 4>{p_.i_hat, p_.i_thigh, p_.i_shank, p_.i_foot}[segment_of(k)];
 }
 
 std::vector<ConstraintInfo> BipedMechanical::constraints() const {
