@@ -12,6 +12,7 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -19,7 +20,9 @@
 #include <thread>
 #include <vector>
 
+#include "core/params.hpp"
 #include "io/lock.hpp"
+#include "io/number.hpp"
 #include "matrix/matrix.hpp"
 #include "methods/pair.hpp"
 #include "problems/registry.hpp"
@@ -199,6 +202,37 @@ TEST(BadInput, CommandLineNumbersTakeNoBlanksAtEitherEnd) {
     EXPECT_EQ(o.code, 2) << "'" << step << "': " << o.out;
     EXPECT_TRUE(contains(o.out, "is not a number")) << o.out;
   }
+}
+
+// One number syntax everywhere (core/params.hpp: is_decimal_number): what
+// strtod reads beyond decimal (hex floats, "infinity", "nan(...)") is
+// refused, on the command line with exit 2 naming the flag, in files as
+// "not a number".
+TEST(BadInput, HexFloatsAndOtherStrtodSpellingsAreNotNumbers) {
+  for (const char* text : {"1e-3", "-0.5", "2.", ".25", "1E+06", "+3"}) EXPECT_TRUE(cstab::is_decimal_number(text)) << text;
+  for (const char* text : {"0x1p-3", "0X10", "infinity", "nan(1)", "1e", "e5", ".", "-", "1.5e+", " 1", "1 ", "1,5",
+                           "0x1.8p1", ""})
+    EXPECT_FALSE(cstab::is_decimal_number(text)) << text;
+  double v = 0;
+  EXPECT_FALSE(cstab::try_parse_number("0x1p-3", v));
+  EXPECT_FALSE(cstab::try_parse_number("Infinity", v));
+  EXPECT_TRUE(cstab::try_parse_number(" 0.125 ", v));
+  EXPECT_EQ(v, 0.125);
+  EXPECT_TRUE(cstab::try_parse_number("-inf", v));  // as format_exact writes it
+  EXPECT_EQ(v, -INFINITY);
+  Scratch s;
+  const std::string run = "run --problem wheel --method pesterev --integrator rk4 --out " + quote(s.dir() / "o") + " ";
+  for (const auto& [args, message] : std::vector<std::pair<std::string, std::string>>{
+           {"--t-end 0.05 --step 0x1p-3", "--step: '0x1p-3' is not a number"},
+           {"--t-end 0x1p-1 --step 1e-3", "--t-end: '0x1p-1' is not a number"},
+           {"--t-end 0.05 --step 1e-3 --param lambda=0x10", "--param lambda: '0x10' is not a number"},
+           {"--t-end 0.05 --step infinity", "--step: 'infinity' is not a finite number"}}) {
+    const Outcome o = cstab_cmd(run + args);
+    EXPECT_EQ(o.code, 2) << args << "\n" << o.out;
+    EXPECT_TRUE(contains(o.out, message)) << args << "\n" << o.out;
+    EXPECT_FALSE(fs::exists(s.dir() / "o")) << args;
+  }
+  EXPECT_EQ(cstab_cmd(run + "--t-end 0.05 --step 0.125e-1").code, 0);
 }
 
 TEST(BadInput, NoSeriesIntoAnOldFolderLeavesNoStaleSeries) {
