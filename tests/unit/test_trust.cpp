@@ -401,6 +401,69 @@ TEST_F(Folder, AFolderInUseIsRefusedNamingItsHolderAndAStaleLockIsTakenOver) {
   EXPECT_EQ(std::stol(slurp(dir / cstab::FolderLock::file_name())) > 0, true);
 }
 
+// A refused `gate --update` (the folder is locked, then the input found
+// bad) leaves no lock file where there was none; one that succeeds keeps
+// it, naming the last holder.
+TEST_F(Folder, ARefusedGateUpdateLeavesNoNewLockFile) {
+  const fs::path dir = copy("gate_refused");
+  fs::remove(dir / cstab::FolderLock::file_name());
+  const std::string row = "problem,method,integrator,setting,status,max_residual\nwheel,pesterev,rk4,step=0.003,ok,1\n";
+  std::ofstream(dir / "t.csv") << row;
+  const std::string before = snapshot(dir);
+  for (const std::string& bad : std::vector<std::string>{
+           "--update --csv " + quote(dir / "c.csv"),  // flags that do not go together
+           "--update --strict",                       // idem
+           "--update --factor 1e308"}) {              // a bound that would overflow
+    const Outcome o = cstab_cmd("gate " + bad + " --thresholds " + quote(dir / "t.csv") + " " + quote(dir));
+    EXPECT_EQ(o.code, 2) << bad << "\n" << o.out;
+    EXPECT_FALSE(fs::exists(dir / cstab::FolderLock::file_name())) << bad << "\n" << o.out;
+    EXPECT_EQ(snapshot(dir), before) << bad;
+  }
+  const Outcome o = cstab_cmd("gate --update --thresholds " + quote(dir / "t.csv") + " " + quote(dir));
+  EXPECT_EQ(o.code, 0) << o.out;
+  EXPECT_TRUE(fs::exists(dir / cstab::FolderLock::file_name()));
+  // An existing lock file stays, refused command or not.
+  const Outcome refused = cstab_cmd("gate --update --strict --thresholds " + quote(dir / "t.csv") + " " + quote(dir));
+  EXPECT_EQ(refused.code, 2) << refused.out;
+  EXPECT_TRUE(fs::exists(dir / cstab::FolderLock::file_name()));
+}
+
+// `merge` reads no shard a matrix is still writing: refused at once naming
+// the holder, nothing written; free again, the same merge succeeds.
+TEST_F(Folder, MergeRefusesAShardLockedByARunningMatrix) {
+  const fs::path busy = copy("busy_shard");
+  const fs::path out = dir_->dir() / "merged_busy";
+  {
+    const cstab::FolderLock held(busy.string(), "cstab matrix");
+    const std::string before = snapshot(busy);
+    const Outcome o = cstab_cmd("merge --no-report " + quote(out) + " " + quote(busy));
+    EXPECT_EQ(o.code, 2) << o.out;
+    EXPECT_TRUE(contains(o.out, busy.string() + ": in use by another cstab command (pid " +
+                                    std::to_string(::getpid()) + " cstab matrix)"))
+        << o.out;
+    EXPECT_FALSE(fs::exists(out));
+    EXPECT_EQ(snapshot(busy), before);
+  }
+  // A shard with no lock file at all (never locked) is read as before.
+  const fs::path plain = copy("plain_shard");
+  fs::remove(plain / cstab::FolderLock::file_name());
+  const Outcome o = cstab_cmd("merge --no-report " + quote(out) + " " + quote(busy));
+  EXPECT_EQ(o.code, 0) << o.out;
+  EXPECT_EQ(cstab::testing::summary_without_timing(out / "summary.csv"),
+            cstab::testing::summary_without_timing(shard() / "summary.csv"));
+  const Outcome o2 = cstab_cmd("merge --no-report " + quote(dir_->dir() / "merged_plain") + " " + quote(plain));
+  EXPECT_EQ(o2.code, 0) << o2.out;
+  EXPECT_FALSE(fs::exists(plain / cstab::FolderLock::file_name()));
+  // While merge holds its reading lock, a matrix on the shard is refused:
+  // the same kernel lock, seen from the other side.
+  {
+    const cstab::FolderLock reading(busy.string(), "cstab merge", cstab::FolderLock::Mode::kRead);
+    const Outcome m = cstab_cmd(matrix_into(busy));
+    EXPECT_EQ(m.code, 2) << m.out;
+    EXPECT_TRUE(contains(m.out, "in use by another cstab command")) << m.out;
+  }
+}
+
 // ------------------------------------------------------------- the cache verifies
 
 TEST_F(Folder, ACachedCaseWhoseFilesChangedIsRerunSayingWhy) {
