@@ -2,8 +2,10 @@
 // limit, default case timeout, bounded stability maps); bad input is
 // refused with exit 2 and leaves nothing behind (integer parameters, case
 // ids, report on a non-results folder, gate bounds that would overflow,
-// malformed cases.csv with file:line:column, --strict / --add-missing); a
-// results folder is locked while a command writes it; a cached case is
+// malformed cases.csv with file:line:column, --strict / --add-missing,
+// numbers that are not decimal); a results folder is locked while a command
+// writes it (a refused command leaves no new lock file; merge refuses a
+// shard a matrix is writing); a cached case is
 // re-verified against the content hashes in its key.txt and rerun, saying
 // why, when a file is missing, truncated, edited or swapped.
 #include <gtest/gtest.h>
