@@ -58,8 +58,8 @@ FolderLock::FolderLock(const std::string& dir, const std::string& command, Mode 
       created = fd >= 0;
     }
     if (fd < 0)
-      throw UsageError(dir + ": cannot " + (mode == Mode::kRead ? "read" : "write") + " the results folder (lock file " +
-                       file_name() + "): " + std::strerror(errno));
+      throw UsageError(dir + ": cannot " + (mode == Mode::kRead ? "read" : "write") +
+                       " the results folder (lock file " + file_name() + "): " + std::strerror(errno));
     if (::flock(fd, (mode == Mode::kRead ? LOCK_SH : LOCK_EX) | LOCK_NB) != 0) {
       const int err = errno;
       if (err == EWOULDBLOCK) refuse_in_use(fd, dir);  // (never one we created: nobody else had it)

@@ -301,8 +301,8 @@ TEST_F(CrashConsistency, KillNineOfTheMatrixOrAWorkerAtTwentyRandomPointsThenThe
   for (int round = 0; round < kFaults; ++round) {
     const bool worker = of_a_worker(rng);
     const double delay = when(rng);
-    SCOPED_TRACE("seed " + std::to_string(seed_) + " (CSTAB_CRASH_SEED), fault " + std::to_string(round) + ": kill -9 of " +
-                 (worker ? "a worker" : "the matrix") + " after " + std::to_string(delay) + " s of a " +
+    SCOPED_TRACE("seed " + std::to_string(seed_) + " (CSTAB_CRASH_SEED), fault " + std::to_string(round) +
+                 ": kill -9 of " + (worker ? "a worker" : "the matrix") + " after " + std::to_string(delay) + " s of a " +
                  std::to_string(full_seconds_) + " s run");
     const fs::path out = dir_->dir() / ("fault" + std::to_string(round));
     const auto start = Clock::now();

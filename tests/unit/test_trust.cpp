@@ -211,7 +211,8 @@ TEST(BadInput, CommandLineNumbersTakeNoBlanksAtEitherEnd) {
 // refused, on the command line with exit 2 naming the flag, in files as
 // "not a number".
 TEST(BadInput, HexFloatsAndOtherStrtodSpellingsAreNotNumbers) {
-  for (const char* text : {"1e-3", "-0.5", "2.", ".25", "1E+06", "+3"}) EXPECT_TRUE(cstab::is_decimal_number(text)) << text;
+  for (const char* text : {"1e-3", "-0.5", "2.", ".25", "1E+06", "+3"})
+    EXPECT_TRUE(cstab::is_decimal_number(text)) << text;
   for (const char* text : {"0x1p-3", "0X10", "infinity", "nan(1)", "1e", "e5", ".", "-", "1.5e+", " 1", "1 ", "1,5",
                            "0x1.8p1", ""})
     EXPECT_FALSE(cstab::is_decimal_number(text)) << text;
