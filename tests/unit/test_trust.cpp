@@ -204,6 +204,15 @@ TEST(BadInput, CommandLineNumbersTakeNoBlanksAtEitherEnd) {
     EXPECT_EQ(o.code, 2) << "'" << step << "': " << o.out;
     EXPECT_TRUE(contains(o.out, "is not a number")) << o.out;
   }
+  // Integer flags too (strtol would skip the leading blank).
+  for (const char* every : {" 2", "2 ", "0x2", "2e0"}) {
+    const Outcome o = cstab_cmd(std::string(kRun) + "--step 1e-3 --observe-every '" + every + "' --out " +
+                                quote(s.dir() / "m"));
+    EXPECT_EQ(o.code, 2) << "'" << every << "': " << o.out;
+    EXPECT_TRUE(contains(o.out, "--observe-every: '" + std::string(every) + "' is not an integer")) << o.out;
+    EXPECT_FALSE(fs::exists(s.dir() / "m"));
+  }
+  EXPECT_EQ(cstab_cmd(std::string(kRun) + "--step 1e-3 --observe-every 2 --out " + quote(s.dir() / "m")).code, 0);
 }
 
 // One number syntax everywhere (core/params.hpp: is_decimal_number): what
