@@ -114,7 +114,11 @@ long Args::integer(const std::string& name) const {
   char* end = nullptr;
   errno = 0;
   const long v = std::strtol(text.c_str(), &end, 10);
-  if (text.empty() || *end != '\0' || errno) throw UsageError(name + ": '" + text + "' is not an integer");
+  // strtol skips leading blanks; an integer is a decimal number without
+  // point or exponent, nothing around it.
+  if (text.empty() || *end != '\0' || errno || !is_decimal_number(text) ||
+      text.find_first_of(".eE") != std::string::npos)
+    throw UsageError(name + ": '" + text + "' is not an integer");
   return v;
 }
 

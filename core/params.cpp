@@ -11,15 +11,42 @@
 
 namespace cstab {
 
+bool is_decimal_number(std::string_view text) {
+  size_t i = 0;
+  auto digits = [&] {
+    const size_t from = i;
+    while (i < text.size() && text[i] >= '0' && text[i] <= '9') ++i;
+    return i - from;
+  };
+  if (i < text.size() && (text[i] == '+' || text[i] == '-')) ++i;
+  size_t mantissa = digits();
+  if (i < text.size() && text[i] == '.') {
+    ++i;
+    mantissa += digits();
+  }
+  if (mantissa == 0) return false;
+  if (i < text.size() && (text[i] == 'e' || text[i] == 'E')) {
+    ++i;
+    if (i < text.size() && (text[i] == '+' || text[i] == '-')) ++i;
+    if (digits() == 0) return false;
+  }
+  return i == text.size();
+}
+
 double parse_finite_double(const std::string& text, const std::string& what) {
   if (text.empty()) throw UsageError(what + ": empty value, expected a number");
   const char* begin = text.c_str();
   char* end = nullptr;
   errno = 0;
   const double value = std::strtod(begin, &end);
-  // strtod skips leading blanks; a command-line number has none at either end.
-  if (end != begin + text.size() || std::isspace(static_cast<unsigned char>(text.front())))
+  // strtod also reads blanks, hex floats ("0x1p-3"), "infinity" and
+  // "nan(...)"; a number here is decimal and nothing else.
+  const bool whole = end == begin + text.size() && !std::isspace(static_cast<unsigned char>(text.front()));
+  if (!is_decimal_number(text)) {
+    if (whole && !std::isfinite(value) && text.find_first_of("xX") == std::string::npos)
+      throw UsageError(what + ": '" + text + "' is not a finite number");
     throw UsageError(what + ": '" + text + "' is not a number");
+  }
   if (!std::isfinite(value))
     throw UsageError(what + ": '" + text + "' is not a finite number");
   return value;

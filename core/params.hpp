@@ -6,6 +6,7 @@
 #include <limits>
 #include <stdexcept>
 #include <string>
+#include <string_view>
 #include <utility>
 #include <vector>
 
@@ -88,7 +89,14 @@ class Params {
   std::vector<std::string> given_;
 };
 
-// Strict number parsing: the whole text must be a finite number.
+// The one number syntax of every flag and file: an optional sign, decimal
+// digits with an optional point, an optional decimal exponent ("1e-3",
+// "-0.5", "2.", ".25", "1E+06"). No blanks, no hex floats ("0x1p-3"), no
+// "infinity" or "nan(...)": what strtod accepts beyond this is refused.
+bool is_decimal_number(std::string_view text);
+
+// Strict number parsing: the whole text must be a finite decimal number
+// (is_decimal_number).
 double parse_finite_double(const std::string& text, const std::string& what);
 
 }  // namespace cstab

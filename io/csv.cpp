@@ -1,5 +1,6 @@
 #include "io/csv.hpp"
 
+#include <sys/statvfs.h>
 #include <unistd.h>
 
 #include <cerrno>
@@ -35,6 +36,16 @@ void release_slot(int slot) {
   if (slot >= 0) g_temp_used[slot] = 0;
 }
 
+// "a write failed", and the space left on the file system of `fd` when it
+// is nearly full (the usual reason).
+std::string space_note(int fd) {
+  struct statvfs fs {};
+  if (::fstatvfs(fd, &fs) != 0) return "a write failed";
+  const unsigned long long free_bytes = static_cast<unsigned long long>(fs.f_bavail) * fs.f_frsize;
+  if (free_bytes >= (1ull << 20)) return "a write failed";
+  return "a write failed with " + std::to_string(free_bytes) + " bytes free on its file system (disk full)";
+}
+
 }  // namespace
 
 void remove_temporary_files() {
@@ -64,10 +75,15 @@ void AtomicFile::write(const std::string& text) {
 
 void AtomicFile::commit() {
   const bool write_error = std::ferror(file_) != 0;
+  // Why, as far as is known: the errno of a failed close (its flush), else
+  // for an earlier failed write (whose errno is gone) the space left.
+  std::string why = write_error ? space_note(::fileno(file_)) : std::string();
+  errno = 0;
   const bool close_error = std::fclose(file_) != 0;
+  if (close_error && errno) why = std::strerror(errno);
   file_ = nullptr;
   if (write_error || close_error)
-    throw IoError("error writing " + path_);
+    throw IoError("error writing " + path_ + (why.empty() ? std::string() : ": " + why));
   if (std::rename(temp_path_.c_str(), path_.c_str()) != 0)
     throw IoError("cannot rename into " + path_ + ": " + std::strerror(errno));
   committed_ = true;

@@ -4,8 +4,10 @@
 #include <cstdio>
 #include <cstdlib>
 #include <limits>
+#include <string_view>
 
 #include "core/format.hpp"
+#include "core/params.hpp"
 
 namespace cstab {
 
@@ -23,15 +25,27 @@ std::string plot_cell(double v) {
 std::string log_plot_cell(double v) { return v > 0 ? plot_cell(v) : "?"; }
 
 bool try_parse_number(const std::string& text, double& value) {
-  const char* begin = text.c_str();
-  while (*begin == ' ' || *begin == '\t') ++begin;
-  if (!*begin) return false;
-  char* end = nullptr;
-  const double v = std::strtod(begin, &end);
-  if (end == begin) return false;
-  while (*end == ' ' || *end == '\t') ++end;
-  if (*end) return false;
-  value = v;
+  size_t begin = 0, end = text.size();
+  while (begin < end && (text[begin] == ' ' || text[begin] == '\t')) ++begin;
+  while (end > begin && (text[end - 1] == ' ' || text[end - 1] == '\t')) --end;
+  const std::string_view cell = std::string_view(text).substr(begin, end - begin);
+  // Decimal (core/params.hpp: is_decimal_number), or the infinities and NaN
+  // format_exact writes; not the rest of what strtod reads (hex floats,
+  // "infinity", "nan(...)").
+  if (cell == "inf" || cell == "+inf") {
+    value = std::numeric_limits<double>::infinity();
+    return true;
+  }
+  if (cell == "-inf") {
+    value = -std::numeric_limits<double>::infinity();
+    return true;
+  }
+  if (cell == "nan") {
+    value = std::numeric_limits<double>::quiet_NaN();
+    return true;
+  }
+  if (!is_decimal_number(cell)) return false;
+  value = std::strtod(text.c_str() + begin, nullptr);  // stops at a trailing blank
   return true;
 }
 

@@ -752,6 +752,7 @@ struct Shards {
   size_t selected_cases = 0;
   std::set<std::string> binaries;
   Provenance provenance;  // every shard's, keys prefixed "shard<k>."
+  std::vector<std::unique_ptr<FolderLock>> locks;  // reading locks: no matrix writes a shard meanwhile
 };
 
 // Adds shard `s` (folder `dir`): same matrix as the first, consistent case ids.
@@ -759,6 +760,9 @@ void read_shard(Shards& shards, const std::string& out_dir, const std::vector<st
   const std::string& dir = shard_dirs[s];
   std::error_code same_ec;
   if (fs::equivalent(dir, out_dir, same_ec)) throw UsageError("the output folder " + out_dir + " is also a shard folder");
+  // A shard a matrix is still writing is refused (naming it), and none
+  // starts on it until the merge is done.
+  shards.locks.push_back(std::make_unique<FolderLock>(dir, "cstab merge", FolderLock::Mode::kRead));
   std::string text;
   try {
     text = read_text_file(dir + "/matrix.toml");

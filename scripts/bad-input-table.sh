@@ -12,7 +12,8 @@
 # by --init from DIV, a two-case folder whose step 3e-3 case diverges),
 # DIVTHR (a row bounding that diverged case's residual), EMPTYTHR (a header-only thresholds file), PARTTHR
 # (THR without its last row), LOCKED (a copy of SHARD whose lock a
-# background `flock` holds), READONLY (a copy of SHARD without write
+# background `flock` holds), NOLOCK (a copy of DIV without its lock file:
+# a refused `gate --update` must not leave one), READONLY (a copy of SHARD without write
 # permission; its row runs as uid 65534 through setpriv). Every row runs
 # under `timeout 900`; SKIP_SLOW=1 skips the row that takes minutes (an
 # adaptive run up to the default step limit of 1e8).
@@ -193,6 +194,8 @@ cases+=(
 "i16_merge_locked|merge LOCKED SHARD"
 "i16_report_locked|report LOCKED"
 "i16_gate_update_locked|gate --update --thresholds THR LOCKED"
+"i16_merge_shard_locked|merge OUT LOCKED"
+"i16_gate_update_refused_no_lock_file|gate --update --factor 1e308 --thresholds DIVTHR NOLOCK"
 "i16_matrix_read_only_folder_as_uid_65534|NOBODY matrix $M/good.toml --out READONLY"
 "list_flag|list --foo"
 "unknown_command|frobnicate"
@@ -211,6 +214,7 @@ head -n -1 $W/thr.csv > $W/partthr.csv
 printf 'problem,method,integrator,setting,status,max_residual\nwheel,pesterev,rk4,step=0.003,diverged,1\n' > $W/divthr.csv
 printf 'problem,method,integrator,setting\n' > $W/emptythr.csv
 cp -r $W/shard $W/locked
+cp -r $W/div $W/nolock; rm -f $W/nolock/.cstab.lock
 cp -r $W/shard $W/readonly; chmod -R a-w $W/readonly; chmod a+rx $W $M; chmod a+r $M/good.toml
 printf '%s\nflock (bad-input-table.sh)\n' $$ > $W/locked/.cstab.lock
 flock $W/locked/.cstab.lock sleep 3600 & lock_holder=$!
@@ -230,12 +234,12 @@ for c in "${cases[@]}"; do
   args=${args//BADID/$W/badid}; args=${args//BADCSV/$W/badcsv}; args=${args//NOCASES/$W/nocases}
   args=${args//EMPTYTHR/$W/emptythr.csv}; args=${args//PARTTHR/$W/partthr.csv}; args=${args//DIVTHR/$W/divthr.csv}
   args=${args//THR/$W/thr.csv}; args=${args//DIV/$W/div}
-  args=${args//LOCKED/$W/locked}; args=${args//READONLY/$W/readonly}
+  args=${args//NOLOCK/$W/nolock}; args=${args//LOCKED/$W/locked}; args=${args//READONLY/$W/readonly}
   run_as=""; [[ $args == NOBODY\ * ]] && { args=${args#NOBODY }; run_as="setpriv --reuid=65534 --regid=65534 --clear-groups"; }
   # the folder a row damages, if any: what changed in it is its "files left"
   target=""
-  for d in badid badcsv nocases locked readonly; do [[ " $args " == *" $W/$d "* ]] && target=$W/$d; done
-  [[ " $args " == *" $W/divthr.csv "* ]] && target=$W/div
+  for d in badid badcsv nocases locked nolock readonly; do [[ " $args " == *" $W/$d "* ]] && target=$W/$d; done
+  [[ -z $target && " $args " == *" $W/divthr.csv "* ]] && target=$W/div
   [ -n "$target" ] && before=$(snap $target; md5sum $W/thr.csv $W/divthr.csv)
   start=$(date +%s.%N)
   timeout 900 $run_as $B $args >$W/stdout 2>$W/stderr; code=$?

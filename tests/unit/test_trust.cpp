@@ -2,8 +2,10 @@
 // limit, default case timeout, bounded stability maps); bad input is
 // refused with exit 2 and leaves nothing behind (integer parameters, case
 // ids, report on a non-results folder, gate bounds that would overflow,
-// malformed cases.csv with file:line:column, --strict / --add-missing); a
-// results folder is locked while a command writes it; a cached case is
+// malformed cases.csv with file:line:column, --strict / --add-missing,
+// numbers that are not decimal); a results folder is locked while a command
+// writes it (a refused command leaves no new lock file; merge refuses a
+// shard a matrix is writing); a cached case is
 // re-verified against the content hashes in its key.txt and rerun, saying
 // why, when a file is missing, truncated, edited or swapped.
 #include <gtest/gtest.h>
@@ -12,6 +14,7 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -19,7 +22,9 @@
 #include <thread>
 #include <vector>
 
+#include "core/params.hpp"
 #include "io/lock.hpp"
+#include "io/number.hpp"
 #include "matrix/matrix.hpp"
 #include "methods/pair.hpp"
 #include "problems/registry.hpp"
@@ -199,6 +204,47 @@ TEST(BadInput, CommandLineNumbersTakeNoBlanksAtEitherEnd) {
     EXPECT_EQ(o.code, 2) << "'" << step << "': " << o.out;
     EXPECT_TRUE(contains(o.out, "is not a number")) << o.out;
   }
+  // Integer flags too (strtol would skip the leading blank).
+  for (const char* every : {" 2", "2 ", "0x2", "2e0"}) {
+    const Outcome o = cstab_cmd(std::string(kRun) + "--step 1e-3 --observe-every '" + every + "' --out " +
+                                quote(s.dir() / "m"));
+    EXPECT_EQ(o.code, 2) << "'" << every << "': " << o.out;
+    EXPECT_TRUE(contains(o.out, "--observe-every: '" + std::string(every) + "' is not an integer")) << o.out;
+    EXPECT_FALSE(fs::exists(s.dir() / "m"));
+  }
+  EXPECT_EQ(cstab_cmd(std::string(kRun) + "--step 1e-3 --observe-every 2 --out " + quote(s.dir() / "m")).code, 0);
+}
+
+// One number syntax everywhere (core/params.hpp: is_decimal_number): what
+// strtod reads beyond decimal (hex floats, "infinity", "nan(...)") is
+// refused, on the command line with exit 2 naming the flag, in files as
+// "not a number".
+TEST(BadInput, HexFloatsAndOtherStrtodSpellingsAreNotNumbers) {
+  for (const char* text : {"1e-3", "-0.5", "2.", ".25", "1E+06", "+3"})
+    EXPECT_TRUE(cstab::is_decimal_number(text)) << text;
+  for (const char* text : {"0x1p-3", "0X10", "infinity", "nan(1)", "1e", "e5", ".", "-", "1.5e+", " 1", "1 ", "1,5",
+                           "0x1.8p1", ""})
+    EXPECT_FALSE(cstab::is_decimal_number(text)) << text;
+  double v = 0;
+  EXPECT_FALSE(cstab::try_parse_number("0x1p-3", v));
+  EXPECT_FALSE(cstab::try_parse_number("Infinity", v));
+  EXPECT_TRUE(cstab::try_parse_number(" 0.125 ", v));
+  EXPECT_EQ(v, 0.125);
+  EXPECT_TRUE(cstab::try_parse_number("-inf", v));  // as format_exact writes it
+  EXPECT_EQ(v, -INFINITY);
+  Scratch s;
+  const std::string run = "run --problem wheel --method pesterev --integrator rk4 --out " + quote(s.dir() / "o") + " ";
+  for (const auto& [args, message] : std::vector<std::pair<std::string, std::string>>{
+           {"--t-end 0.05 --step 0x1p-3", "--step: '0x1p-3' is not a number"},
+           {"--t-end 0x1p-1 --step 1e-3", "--t-end: '0x1p-1' is not a number"},
+           {"--t-end 0.05 --step 1e-3 --param lambda=0x10", "--param lambda: '0x10' is not a number"},
+           {"--t-end 0.05 --step infinity", "--step: 'infinity' is not a finite number"}}) {
+    const Outcome o = cstab_cmd(run + args);
+    EXPECT_EQ(o.code, 2) << args << "\n" << o.out;
+    EXPECT_TRUE(contains(o.out, message)) << args << "\n" << o.out;
+    EXPECT_FALSE(fs::exists(s.dir() / "o")) << args;
+  }
+  EXPECT_EQ(cstab_cmd(run + "--t-end 0.05 --step 0.125e-1").code, 0);
 }
 
 TEST(BadInput, NoSeriesIntoAnOldFolderLeavesNoStaleSeries) {
@@ -365,6 +411,69 @@ TEST_F(Folder, AFolderInUseIsRefusedNamingItsHolderAndAStaleLockIsTakenOver) {
   const Outcome o = cstab_cmd(matrix_into(dir));
   EXPECT_EQ(o.code, 0) << o.out;
   EXPECT_EQ(std::stol(slurp(dir / cstab::FolderLock::file_name())) > 0, true);
+}
+
+// A refused `gate --update` (the folder is locked, then the input found
+// bad) leaves no lock file where there was none; one that succeeds keeps
+// it, naming the last holder.
+TEST_F(Folder, ARefusedGateUpdateLeavesNoNewLockFile) {
+  const fs::path dir = copy("gate_refused");
+  fs::remove(dir / cstab::FolderLock::file_name());
+  const std::string row = "problem,method,integrator,setting,status,max_residual\nwheel,pesterev,rk4,step=0.003,ok,1\n";
+  std::ofstream(dir / "t.csv") << row;
+  const std::string before = snapshot(dir);
+  for (const std::string& bad : std::vector<std::string>{
+           "--update --csv " + quote(dir / "c.csv"),  // flags that do not go together
+           "--update --strict",                       // idem
+           "--update --factor 1e308"}) {              // a bound that would overflow
+    const Outcome o = cstab_cmd("gate " + bad + " --thresholds " + quote(dir / "t.csv") + " " + quote(dir));
+    EXPECT_EQ(o.code, 2) << bad << "\n" << o.out;
+    EXPECT_FALSE(fs::exists(dir / cstab::FolderLock::file_name())) << bad << "\n" << o.out;
+    EXPECT_EQ(snapshot(dir), before) << bad;
+  }
+  const Outcome o = cstab_cmd("gate --update --thresholds " + quote(dir / "t.csv") + " " + quote(dir));
+  EXPECT_EQ(o.code, 0) << o.out;
+  EXPECT_TRUE(fs::exists(dir / cstab::FolderLock::file_name()));
+  // An existing lock file stays, refused command or not.
+  const Outcome refused = cstab_cmd("gate --update --strict --thresholds " + quote(dir / "t.csv") + " " + quote(dir));
+  EXPECT_EQ(refused.code, 2) << refused.out;
+  EXPECT_TRUE(fs::exists(dir / cstab::FolderLock::file_name()));
+}
+
+// `merge` reads no shard a matrix is still writing: refused at once naming
+// the holder, nothing written; free again, the same merge succeeds.
+TEST_F(Folder, MergeRefusesAShardLockedByARunningMatrix) {
+  const fs::path busy = copy("busy_shard");
+  const fs::path out = dir_->dir() / "merged_busy";
+  {
+    const cstab::FolderLock held(busy.string(), "cstab matrix");
+    const std::string before = snapshot(busy);
+    const Outcome o = cstab_cmd("merge --no-report " + quote(out) + " " + quote(busy));
+    EXPECT_EQ(o.code, 2) << o.out;
+    EXPECT_TRUE(contains(o.out, busy.string() + ": in use by another cstab command (pid " +
+                                    std::to_string(::getpid()) + " cstab matrix)"))
+        << o.out;
+    EXPECT_FALSE(fs::exists(out));
+    EXPECT_EQ(snapshot(busy), before);
+  }
+  // A shard with no lock file at all (never locked) is read as before.
+  const fs::path plain = copy("plain_shard");
+  fs::remove(plain / cstab::FolderLock::file_name());
+  const Outcome o = cstab_cmd("merge --no-report " + quote(out) + " " + quote(busy));
+  EXPECT_EQ(o.code, 0) << o.out;
+  EXPECT_EQ(cstab::testing::summary_without_timing(out / "summary.csv"),
+            cstab::testing::summary_without_timing(shard() / "summary.csv"));
+  const Outcome o2 = cstab_cmd("merge --no-report " + quote(dir_->dir() / "merged_plain") + " " + quote(plain));
+  EXPECT_EQ(o2.code, 0) << o2.out;
+  EXPECT_FALSE(fs::exists(plain / cstab::FolderLock::file_name()));
+  // While merge holds its reading lock, a matrix on the shard is refused:
+  // the same kernel lock, seen from the other side.
+  {
+    const cstab::FolderLock reading(busy.string(), "cstab merge", cstab::FolderLock::Mode::kRead);
+    const Outcome m = cstab_cmd(matrix_into(busy));
+    EXPECT_EQ(m.code, 2) << m.out;
+    EXPECT_TRUE(contains(m.out, "in use by another cstab command")) << m.out;
+  }
 }
 
 // ------------------------------------------------------------- the cache verifies
