@@ -76,24 +76,19 @@ struct Ali3pSettings {
 };
 
 template <class Model>
-class Ali3pFormulation final : public MechanicalFormulationBase<Model>, public SteppingSystem {
-  using Base = MechanicalFormulationBase<Model>;
+class Ali3pFormulation final : public SelfSteppingFormulation<Model> {
+  using Base = SelfSteppingFormulation<Model>;
 
  public:
-  CSTAB_MECHANICAL_SIZES(Base);
+  CSTAB_SELF_STEPPING_MEMBERS(Base);
   static constexpr int kA = 2 * nq, kLambda = 3 * nq, kDim = 3 * nq + nc;
   using MatQ = Eigen::Matrix<double, nq, nq>;
   using VecC = Vec<double, nc>;
 
   Ali3pFormulation(const Model& model, const char* method, const Ali3pSettings& settings)
-      : Base(model), method_(method), settings_(settings) {}
+      : Base(model, method), settings_(settings) {}
 
   int dimension() const override { return kDim; }
-
-  bool rhs(double, const double*, double*) override {
-    this->failure_ = std::string(method_) + " is its own implicit time-stepping scheme: it needs --integrator own";
-    return false;
-  }
 
   void initial_state(double* y) const override {
     VecQ q, v;
@@ -125,17 +120,7 @@ class Ali3pFormulation final : public MechanicalFormulationBase<Model>, public S
     if constexpr (nc > 0) vmap<nc>(y + kLambda) = lambda;
   }
 
-  void set_step_hint(double h) override { step_hint_ = h; }
-
-  long evaluations() const override { return evaluations_; }
-  std::vector<std::pair<std::string, std::string>> statistics() const override {
-    return {{"newton_iters", std::to_string(iterations_)},
-            {"newton_conv_fails", std::to_string(failures_)},
-            {"newton_max_iters_per_step", std::to_string(max_per_step_)}};
-  }
-
   // Condition number of W at y for the run's step.
-  bool has_condition_number() const override { return step_hint_ > 0; }
   double condition_number(double t, const double* y) override {
     if (!(step_hint_ > 0)) return std::nan("");
     const double h = step_hint_;
@@ -184,10 +169,8 @@ class Ali3pFormulation final : public MechanicalFormulationBase<Model>, public S
         break;
       }
     }
-    iterations_ += it;
-    max_per_step_ = std::max<long>(max_per_step_, it);
+    count_step(it, converged);
     if (!converged) {
-      ++failures_;
       this->failure_ = std::string(method_) + ": the augmented Lagrangian iteration did not converge in " +
                        std::to_string(it) + " iterations at t = " + format_short(t1) + " (last relative correction " +
                        format_short(correction) + ", constraints " + format_short(violation) + ")";
@@ -249,10 +232,7 @@ class Ali3pFormulation final : public MechanicalFormulationBase<Model>, public S
     return p_;
   }
 
-  const char* method_;
   Ali3pSettings settings_;
-  double step_hint_ = 0;
-  long evaluations_ = 0, iterations_ = 0, failures_ = 0, max_per_step_ = 0;
   // Workspaces (no allocation per step).
   NewtonTerms<Model> terms_;
   MechanicalTerms<Model> projection_terms_;

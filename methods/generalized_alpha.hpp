@@ -96,11 +96,11 @@ struct AlphaSettings {
 };
 
 template <class Model, bool kIndex2>
-class GeneralizedAlphaFormulation final : public MechanicalFormulationBase<Model>, public SteppingSystem {
-  using Base = MechanicalFormulationBase<Model>;
+class GeneralizedAlphaFormulation final : public SelfSteppingFormulation<Model> {
+  using Base = SelfSteppingFormulation<Model>;
 
  public:
-  CSTAB_MECHANICAL_SIZES(Base);
+  CSTAB_SELF_STEPPING_MEMBERS(Base);
   static constexpr int nm = kIndex2 ? nh : 0;           // nu: the index-2 position correction
   static constexpr int nv = kIndex2 ? nc : nn;          // velocity-level rows in the step
   static constexpr int kA = 2 * nq, kVdot = 3 * nq, kLambda = 4 * nq, kNu = 4 * nq + nc;
@@ -110,14 +110,9 @@ class GeneralizedAlphaFormulation final : public MechanicalFormulationBase<Model
   using VecN = Vec<double, kN>;
 
   GeneralizedAlphaFormulation(const Model& model, const char* method, const AlphaSettings& settings)
-      : Base(model), method_(method), settings_(settings) {}
+      : Base(model, method), settings_(settings) {}
 
   int dimension() const override { return kDim; }
-
-  bool rhs(double, const double*, double*) override {
-    this->failure_ = std::string(method_) + " is its own implicit time-stepping scheme: it needs --integrator own";
-    return false;
-  }
 
   void initial_state(double* y) const override {
     MechanicalDaeFormulation<Model, false> dae(this->model_, method_);
@@ -134,17 +129,7 @@ class GeneralizedAlphaFormulation final : public MechanicalFormulationBase<Model
     }
   }
 
-  void set_step_hint(double h) override { step_hint_ = h; }
-
-  long evaluations() const override { return evaluations_; }
-  std::vector<std::pair<std::string, std::string>> statistics() const override {
-    return {{"newton_iters", std::to_string(newton_iterations_)},
-            {"newton_conv_fails", std::to_string(newton_failures_)},
-            {"newton_max_iters_per_step", std::to_string(newton_max_per_step_)}};
-  }
-
   // Condition number of the (scaled) Newton matrix at y for the run's step.
-  bool has_condition_number() const override { return step_hint_ > 0; }
   double condition_number(double t, const double* y) override {
     if (!(step_hint_ > 0)) return std::nan("");
     const long counted = evaluations_;  // an observation, not a step's work
@@ -218,10 +203,8 @@ class GeneralizedAlphaFormulation final : public MechanicalFormulationBase<Model
         break;
       }
     }
-    newton_iterations_ += it;
-    newton_max_per_step_ = std::max<long>(newton_max_per_step_, it);
+    count_step(it, converged);
     if (!converged) {
-      ++newton_failures_;
       this->failure_ = std::string(method_) + ": Newton iteration did not converge in " + std::to_string(it) +
                        " iterations at t = " + format_short(t1) + " (last relative correction " +
                        format_short(correction) + ")";
@@ -284,10 +267,7 @@ class GeneralizedAlphaFormulation final : public MechanicalFormulationBase<Model
     }
   }
 
-  const char* method_;
   AlphaSettings settings_;
-  double step_hint_ = 0;
-  long evaluations_ = 0, newton_iterations_ = 0, newton_failures_ = 0, newton_max_per_step_ = 0;
   // Workspaces (no allocation per step).
   NewtonTerms<Model> terms_;
   MatN S_;

@@ -51,6 +51,29 @@
 
 namespace cstab {
 
+// The sizes of a mechanical model, for classes that need nothing else of it.
+template <class Model>
+struct MechanicalSizes {
+  static constexpr int nq = Model::kCoords;
+  static constexpr int nh = Model::kHolonomic;
+  static constexpr int nn = Model::kNonholonomic;
+  static constexpr int nc = nh + nn;
+  using VecQ = Vec<double, nq>;
+};
+
+// What a class template names of its base (MechanicalSizes, a
+// MechanicalFormulationBase or a class derived from them): members of a
+// dependent base are not found by plain lookup, so each formulation writes
+//   using Base = MechanicalFormulationBase<Model>;
+//  public:
+//   CSTAB_MECHANICAL_SIZES(Base);
+#define CSTAB_MECHANICAL_SIZES(Base) \
+  using Base::nc;                    \
+  using Base::nh;                    \
+  using Base::nn;                    \
+  using Base::nq;                    \
+  using typename Base::VecQ
+
 template <class Model>
 struct MechanicalTerms;
 
@@ -70,12 +93,8 @@ inline constexpr bool closed_form_nonholonomic_exact =
 }  // namespace contracts::detail
 
 template <class Model>
-struct MechanicalTerms {
-  static constexpr int nq = Model::kCoords;
-  static constexpr int nh = Model::kHolonomic;
-  static constexpr int nn = Model::kNonholonomic;
-  static constexpr int nc = nh + nn;
-  using VecQ = Vec<double, nq>;
+struct MechanicalTerms : MechanicalSizes<Model> {
+  CSTAB_MECHANICAL_SIZES(MechanicalSizes<Model>);
   using MatQ = Eigen::Matrix<double, nq, nq>;
 
   MatQ M;
@@ -252,28 +271,12 @@ void MechanicalTerms<Model>::nonholonomic_terms(const Model& model, double t, co
   }
 }
 
-// What a formulation class template names of its base (a
-// MechanicalFormulationBase or a class derived from it): members of a
-// dependent base are not found by plain lookup, so each formulation writes
-//   using Base = MechanicalFormulationBase<Model>;
-//  public:
-//   CSTAB_MECHANICAL_SIZES(Base);
-#define CSTAB_MECHANICAL_SIZES(Base) \
-  using Base::nc;                    \
-  using Base::nh;                    \
-  using Base::nn;                    \
-  using Base::nq;                    \
-  using typename Base::VecQ
 
 // Shared parts of every formulation on y = [q; v].
 template <class Model>
-class MechanicalFormulationBase : public Formulation {
+class MechanicalFormulationBase : public Formulation, public MechanicalSizes<Model> {
  public:
-  static constexpr int nq = Model::kCoords;
-  static constexpr int nh = Model::kHolonomic;
-  static constexpr int nn = Model::kNonholonomic;
-  static constexpr int nc = nh + nn;
-  using VecQ = Vec<double, nq>;
+  CSTAB_MECHANICAL_SIZES(MechanicalSizes<Model>);
 
   explicit MechanicalFormulationBase(const Model& model) : model_(model), constraints_(model.constraints()) {}
 

@@ -82,5 +82,6 @@ bool Andrews::reference(double t, double* canonical) const {
 
 // The model's AD evaluations, instantiated once (extern in the header).
 template struct MechanicalTerms<AndrewsMechanical>;
+template struct NewtonTerms<AndrewsMechanical>;
 
 }  // namespace cstab

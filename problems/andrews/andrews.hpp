@@ -31,6 +31,7 @@
 #include "core/problem.hpp"
 #include "methods/affine.hpp"
 #include "methods/mechanical.hpp"
+#include "methods/newton_terms.hpp"
 #include "problems/common/trig_rows.hpp"
 
 namespace cstab {
@@ -213,5 +214,6 @@ class Andrews {
 
 // Compiled once, in andrews.cpp; the method units reuse it.
 extern template struct MechanicalTerms<AndrewsMechanical>;
+extern template struct NewtonTerms<AndrewsMechanical>;
 
 }  // namespace cstab

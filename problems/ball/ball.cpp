@@ -214,5 +214,6 @@ bool Ball::reference(double t, double* canonical) const { return reference_.at(t
 
 // The model's AD evaluations, instantiated once (extern in the header).
 template struct MechanicalTerms<BallMechanical>;
+template struct NewtonTerms<BallMechanical>;
 
 }  // namespace cstab

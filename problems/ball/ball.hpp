@@ -65,6 +65,7 @@
 #include "problems/common/reference_cache.hpp"
 #include "methods/affine.hpp"
 #include "methods/mechanical.hpp"
+#include "methods/newton_terms.hpp"
 
 namespace cstab {
 
@@ -314,5 +315,6 @@ class Ball {
 
 // Compiled once, in ball.cpp; the method units reuse it.
 extern template struct MechanicalTerms<BallMechanical>;
+extern template struct NewtonTerms<BallMechanical>;
 
 }  // namespace cstab

@@ -316,5 +316,6 @@ ProblemInfo Biped::info() const {
 
 // The model's AD evaluations, instantiated once (extern in the header).
 template struct MechanicalTerms<BipedMechanical>;
+template struct NewtonTerms<BipedMechanical>;
 
 }  // namespace cstab

@@ -122,6 +122,7 @@
 #include "core/problem.hpp"
 #include "methods/affine.hpp"
 #include "methods/mechanical.hpp"
+#include "methods/newton_terms.hpp"
 
 namespace cstab {
 
@@ -349,5 +350,6 @@ class Biped {
 
 // Compiled once, in biped.cpp; the method units reuse it.
 extern template struct MechanicalTerms<BipedMechanical>;
+extern template struct NewtonTerms<BipedMechanical>;
 
 }  // namespace cstab

@@ -38,5 +38,6 @@ bool CarAxis::reference(double t, double* canonical) const {
 
 // The model's AD evaluations, instantiated once (extern in the header).
 template struct MechanicalTerms<CarAxisMechanical>;
+template struct NewtonTerms<CarAxisMechanical>;
 
 }  // namespace cstab

@@ -26,6 +26,7 @@
 #include "core/problem.hpp"
 #include "methods/affine.hpp"
 #include "methods/mechanical.hpp"
+#include "methods/newton_terms.hpp"
 
 namespace cstab {
 
@@ -137,5 +138,6 @@ class CarAxis {
 
 // Compiled once, in car_axis.cpp; the method units reuse it.
 extern template struct MechanicalTerms<CarAxisMechanical>;
+extern template struct NewtonTerms<CarAxisMechanical>;
 
 }  // namespace cstab

@@ -123,5 +123,6 @@ bool SliderCrank::reference(double t, double* canonical) const { return referenc
 
 // The model's AD evaluations, instantiated once (extern in the header).
 template struct MechanicalTerms<SliderCrankMechanical>;
+template struct NewtonTerms<SliderCrankMechanical>;
 
 }  // namespace cstab

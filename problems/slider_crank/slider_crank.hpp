@@ -40,6 +40,7 @@
 #include "problems/common/reference_cache.hpp"
 #include "methods/affine.hpp"
 #include "methods/mechanical.hpp"
+#include "methods/newton_terms.hpp"
 #include "problems/common/trig_rows.hpp"
 
 namespace cstab {
@@ -167,5 +168,6 @@ class SliderCrank {
 
 // Compiled once, in slider_crank.cpp; the method units reuse it.
 extern template struct MechanicalTerms<SliderCrankMechanical>;
+extern template struct NewtonTerms<SliderCrankMechanical>;
 
 }  // namespace cstab

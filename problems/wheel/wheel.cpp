@@ -211,5 +211,6 @@ bool Wheel::reference(double t, double* canonical) const { return reference_.at(
 
 // The model's AD evaluations, instantiated once (extern in the header).
 template struct MechanicalTerms<WheelMechanical>;
+template struct NewtonTerms<WheelMechanical>;
 
 }  // namespace cstab

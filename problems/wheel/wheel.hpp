@@ -30,6 +30,7 @@
 #include "problems/common/reference_cache.hpp"
 #include "methods/affine.hpp"
 #include "methods/mechanical.hpp"
+#include "methods/newton_terms.hpp"
 
 namespace cstab {
 
@@ -392,5 +393,6 @@ class Wheel {
 
 // Compiled once, in wheel.cpp; the method units reuse it.
 extern template struct MechanicalTerms<WheelMechanical>;
+extern template struct NewtonTerms<WheelMechanical>;
 
 }  // namespace cstab
