@@ -34,6 +34,7 @@ int cmd_list(const Args&) {
   for (const auto& p : all_problems()) {
     const auto& info = p->info();
     out << "  " << info.name << ": " << info.description << "\n";
+    for (const auto& s : p->problem_params()) out << "    --problem-param " << param_line(s) << "\n";
     out << "    coordinates: ";
     for (size_t i = 0; i < info.coordinates.size(); ++i) out << (i ? "," : "") << info.coordinates[i];
     out << "\n    first integrals: " << (info.has_energy ? "energy" : "none (no energy law)");
@@ -58,9 +59,7 @@ int cmd_list(const Args&) {
   out << "METHODS\n";
   for (const auto& m : all_methods()) {
     out << "  " << m.name << ": " << m.description << "\n";
-    for (const auto& s : m.params)
-      out << "    --param " << s.name << "=" << format_short(s.default_value) << "  (" << bound_text(s)
-          << ") " << s.description << "\n";
+    for (const auto& s : m.params) out << "    --param " << param_line(s) << "\n";
   }
   out << "INTEGRATORS\n";
   for (const auto& i : all_integrators())
@@ -115,6 +114,7 @@ StepSettings step_settings(const Args& args, const IntegratorInfo& integ) {
 int cmd_run(const Args& args) {
   RunConfig cfg;
   cfg.problem = args.require("--problem");
+  cfg.problem_params = args.pairs("--problem-param");
   cfg.method = args.require("--method");
   cfg.formulation = args.get("--formulation");
   cfg.integrator = args.require("--integrator");
@@ -142,7 +142,8 @@ int cmd_run(const Args& args) {
   const std::string out = args.require("--out");
 
   const RunResult r = run_case(problem, cfg, out);
-  std::cout << r.problem << " / " << r.formulation << " / " << r.method << " / " << r.integrator << ": "
+  std::cout << r.problem << (r.problem_params.empty() ? "" : " (" + r.problem_params + ")") << " / "
+            << r.formulation << " / " << r.method << " / " << r.integrator << ": "
             << r.status << (r.reason.empty() ? "" : " (" + r.reason + ")") << ", t = " << r.t_reached
             << ", steps " << r.steps << ", rhs " << r.rhs_evals << ", wall " << r.wall_seconds << " s"
             << ", max residual " << r.max_residual;
@@ -164,7 +165,9 @@ struct Command {
 
 const std::vector<Command>& commands() {
   static const std::vector<Command> table = {
-      {"list", "List the problems (formulations, constraints, reference), methods (--param defaults), integrators",
+      {"list",
+       "List the problems (--problem-param defaults, formulations, constraints, reference), methods (--param "
+       "defaults), integrators",
        "", declare_list, cmd_list},
       {"run", "Run one case; write DIR/summary.csv and DIR/series.csv (README.md: every column)",
        "A diverged run is a recorded result (exit 0; its status says so).", declare_run, cmd_run},
@@ -306,6 +309,7 @@ std::string parse_error_text(const CLI::ParseError& e, const CommandLine& cli) {
 
 void declare_case_options(Args& a) {
   a.required("--problem", "P", "problem (`cstab list` lists them)")
+      .repeatable("--problem-param", "NAME=VALUE", "problem parameter (`cstab list`: each with its default and range)")
       .required("--method", "M", "stabilization method (`cstab list`)")
       .value("--formulation", "F", "formulation of the problem (default: the method's own)")
       .repeatable("--param", "NAME=VALUE", "method parameter (`cstab list`: each with its default)")

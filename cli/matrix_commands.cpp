@@ -126,6 +126,32 @@ repeats = 1
 work_precision = false
 optional = true
 
+# The IFToMM benchmark A01 (the pendulum): its 2000 s horizon, scored at the
+# end (position within 1e-1 and 1e-3 of the reference: low and high precision).
+[[sweep]]
+name = "paper-iftomm-a01"
+problems = ["pendulum"]
+methods = ["minimal", "projection", "baumgarte"]
+integrators = ["rk8pd"]
+tol = [1e-6, 1e-8, 1e-10]
+t_end = 2000
+ref_time = 2000
+repeats = 1
+work_precision = false
+optional = true
+
+[[sweep]]
+name = "paper-iftomm-a01-own"
+problems = ["pendulum"]
+methods = ["ali3p"]
+integrators = ["own"]
+step = [1e-3, 1e-4]
+t_end = 2000
+ref_time = 2000
+repeats = 1
+work_precision = false
+optional = true
+
 # Braun, Goldfarb: RK4, dt = 1e-2, t in [0, 100].
 [[sweep]]
 name = "paper-braun-goldfarb"

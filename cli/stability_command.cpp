@@ -41,6 +41,7 @@ namespace {
 StabilityConfig read_stability(const Args& args, const Problem& problem) {
   StabilityConfig cfg;
   cfg.base.problem = args.require("--problem");
+  cfg.base.problem_params = args.pairs("--problem-param");
   cfg.base.method = args.require("--method");
   cfg.base.formulation = args.get("--formulation");
   cfg.base.integrator = args.require("--integrator");

@@ -62,6 +62,23 @@ std::string param_value_problem(const ParamSpec& spec, double value) {
 Params Params::resolve(const std::vector<ParamSpec>& specs,
                        const std::vector<std::pair<std::string, std::string>>& given,
                        const std::string& method_name) {
+  return resolve_for(specs, given, "--param", "method '" + method_name + "'");
+}
+
+namespace {
+
+// "a (> 0), b (an integer in [1, 10])": the names a message offers instead.
+std::string known_params(const std::vector<ParamSpec>& specs) {
+  std::string known;
+  for (const auto& s : specs) known += (known.empty() ? "" : ", ") + s.name + " (" + bound_text(s) + ")";
+  return known.empty() ? "none" : known;
+}
+
+}  // namespace
+
+Params Params::resolve_for(const std::vector<ParamSpec>& specs,
+                           const std::vector<std::pair<std::string, std::string>>& given, const std::string& flag,
+                           const std::string& owner) {
   Params p;
   for (const auto& s : specs) p.values_.emplace_back(s.name, s.default_value);
   for (const auto& given_pair : given) {
@@ -70,22 +87,28 @@ Params Params::resolve(const std::vector<ParamSpec>& specs,
     const std::string& text = given_pair.second;
     auto it = std::find_if(specs.begin(), specs.end(),
                            [&](const ParamSpec& s) { return s.name == name; });
-    if (it == specs.end()) {
-      std::string known;
-      for (const auto& s : specs) known += (known.empty() ? "" : ", ") + s.name;
-      throw UsageError("--param " + name + ": unknown parameter for method '" + method_name +
-                       "' (known: " + (known.empty() ? "none" : known) + ")");
-    }
+    if (it == specs.end())
+      throw UsageError(flag + " " + name + ": unknown parameter for " + owner + " (known: " + known_params(specs) +
+                       ")");
     if (std::find(p.given_.begin(), p.given_.end(), name) != p.given_.end())
-      throw UsageError("--param " + name + ": given more than once");
-    const double value = parse_finite_double(text, "--param " + name);
+      throw UsageError(flag + " " + name + ": given more than once");
+    double value = 0;
+    try {
+      value = parse_finite_double(text, flag + " " + name);
+    } catch (const UsageError& e) {
+      throw UsageError(std::string(e.what()) + " (" + name + " must be " + bound_text(*it) + ")");
+    }
     const std::string problem = param_value_problem(*it, value);
-    if (!problem.empty()) throw UsageError("--param " + name + "=" + text + ": " + problem);
+    if (!problem.empty()) throw UsageError(flag + " " + name + "=" + text + ": " + problem);
     for (auto& [n, v] : p.values_)
       if (n == name) v = value;
     p.given_.push_back(name);
   }
   return p;
+}
+
+std::string param_line(const ParamSpec& spec) {
+  return spec.name + "=" + format_short(spec.default_value) + "  (" + bound_text(spec) + ") " + spec.description;
 }
 
 std::string bound_text(const ParamSpec& spec) {

@@ -1,5 +1,6 @@
-// Method parameters: a declared list of named real values with defaults and
-// bounds, parsed once from "--param name=value" before a run starts.
+// Parameters of a method ("--param name=value") or of a problem
+// ("--problem-param name=value"): a declared list of named real values with
+// defaults and bounds, parsed once before a run starts.
 #pragma once
 
 #include <cmath>
@@ -62,6 +63,9 @@ std::string bound_violation(const ParamSpec& spec, double value);
 // `max_value`: "must be > 0", "must be a whole number", ...); "" if it is.
 std::string param_value_problem(const ParamSpec& spec, double value);
 
+// "NAME=DEFAULT  (BOUND) DESCRIPTION", one line of `cstab list`.
+std::string param_line(const ParamSpec& spec);
+
 // The method's gain: its first kRate or kTimeScale parameter (nullptr if none).
 const ParamSpec* find_gain(const std::vector<ParamSpec>& specs);
 // The decay rate a gain value implies (value, or 1 / value for a time scale).
@@ -77,6 +81,11 @@ class Params {
   static Params resolve(const std::vector<ParamSpec>& specs,
                         const std::vector<std::pair<std::string, std::string>>& given,
                         const std::string& method_name);
+  // The same for any owner: `flag` starts each message ("--problem-param"),
+  // `owner` names whose parameters they are ("problem 'pendulum'").
+  static Params resolve_for(const std::vector<ParamSpec>& specs,
+                            const std::vector<std::pair<std::string, std::string>>& given, const std::string& flag,
+                            const std::string& owner);
 
   double get(const std::string& name) const;
   bool has(const std::string& name) const;

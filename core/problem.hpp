@@ -94,7 +94,22 @@ class Problem {
   virtual void first_integrals(double /*t*/, const double* /*canonical*/, double* /*out*/) const {}
   // Canonical state of the reference solution at time t; false if none.
   virtual bool reference(double /*t*/, double* /*canonical*/) const { return false; }
+
+  // The problem's own parameters (a length, a size N), each with its
+  // default and range, like a method's; empty: it has none.
+  virtual std::vector<ParamSpec> problem_params() const { return {}; }
+  // This problem with other parameter values (resolved against problem_params()).
+  virtual std::unique_ptr<Problem> with_params(const Params& /*params*/) const { return nullptr; }
 };
+
+// The problem a run uses: `base` with the `--problem-param` values `given`
+// (validated against base.problem_params(); UsageError naming the parameter
+// and its range). `values` receives every parameter's value ("a=1;b=2",
+// defaults included; "" for a problem without parameters). Returns nullptr
+// when nothing is given: `base` itself is the problem.
+std::unique_ptr<Problem> problem_variant(const Problem& base,
+                                         const std::vector<std::pair<std::string, std::string>>& given,
+                                         std::string* values = nullptr);
 
 
 }  // namespace cstab

@@ -657,7 +657,8 @@ std::vector<std::string> append_rows(ThresholdsFile& file, const std::string& di
   // (and the sweep) only then.
   std::map<std::string, int> key_count, key_t_count;
   auto key_of = [](const CaseEntry& e) {
-    return e.problem + "|" + e.method + "|" + e.formulation + "|" + e.integrator + "|" + e.params + "|" + e.setting;
+    return e.problem_label() + "|" + e.method + "|" + e.formulation + "|" + e.integrator + "|" + e.params + "|" +
+           e.setting;
   };
   auto key_t_of = [&](const CaseEntry& e) { return key_of(e) + "|" + format_exact(e.t_end); };
   for (const auto& e : entries) {

@@ -214,8 +214,11 @@ double significant_digits(const std::vector<double>& y, const std::vector<double
   return worst == 0 ? 17.0 : std::min(17.0, -std::log10(worst));
 }
 
-RunResult run_case(const Problem& problem, const RunConfig& cfg, const std::string& out_dir) {
+RunResult run_case(const Problem& registered, const RunConfig& cfg, const std::string& out_dir) {
   // ---- validate everything before any file is created ----
+  std::string problem_params;
+  const std::unique_ptr<Problem> variant = problem_variant(registered, cfg.problem_params, &problem_params);
+  const Problem& problem = variant ? *variant : registered;
   const IntegratorInfo& integ_info = find_integrator(cfg.integrator);
   check_positive_finite(cfg.t_end, "--t-end");
   if (!(cfg.max_steps >= 1) || !std::isfinite(cfg.max_steps) || cfg.max_steps > 1e15)
@@ -265,6 +268,7 @@ RunResult run_case(const Problem& problem, const RunConfig& cfg, const std::stri
 
   RunResult result;
   result.problem = cfg.problem;
+  result.problem_params = problem_params;
   result.formulation = form->formulation_name();
   result.method = cfg.method;
   result.params = params.describe();
@@ -407,6 +411,7 @@ std::vector<std::pair<std::string, std::string>> RunResult::summary_row() const 
   // Measured values round-trip exact, "" for none (io/number.hpp); settings in shortest form.
   const auto num = number_cell;
   row.emplace_back("problem", problem);
+  row.emplace_back("problem_params", problem_params);
   row.emplace_back("formulation", formulation);
   row.emplace_back("method", method);
   row.emplace_back("params", params);

@@ -22,6 +22,7 @@ inline constexpr double kDefaultMaxSteps = 1e8;
 
 struct RunConfig {
   std::string problem;
+  std::vector<std::pair<std::string, std::string>> problem_params;  // name, value text (--problem-param)
   std::string method;
   std::string formulation;  // empty: the method's default for this problem
   std::string integrator;
@@ -56,6 +57,7 @@ struct ConstraintMetrics {
 
 struct RunResult {
   std::string problem, formulation, method, params, integrator;
+  std::string problem_params;  // every problem parameter, "a=1;b=2" ("" for a problem without any)
   std::string status = "ok";  // ok | diverged | failed
   std::string reason;
   double fail_time = std::numeric_limits<double>::quiet_NaN();
@@ -94,7 +96,8 @@ struct RunResult {
 };
 
 // Validates everything (throws UsageError) before touching the filesystem.
-// With out_dir empty nothing is written.
+// With out_dir empty nothing is written. `problem` is the registered problem;
+// config.problem_params, when given, run a variant of it (problem_variant).
 RunResult run_case(const Problem& problem, const RunConfig& config, const std::string& out_dir);
 
 // The deterministic inconsistent start: y_i += delta * sin(i + 1) for every

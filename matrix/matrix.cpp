@@ -498,10 +498,11 @@ class Settings {
     return list(key, Kind::kString);
   }
 
-  std::vector<const MatrixEntry*> params() const {
+  // The keys starting with `prefix` ("param." or "problem_param.").
+  std::vector<const MatrixEntry*> params(const std::string& prefix) const {
     std::vector<const MatrixEntry*> out;
     for (const auto& [key, e] : values_)
-      if (key.rfind("param.", 0) == 0) out.push_back(e);
+      if (key.rfind(prefix, 0) == 0) out.push_back(e);
     // file order: defaults first, then the sweep's own
     std::sort(out.begin(), out.end(), [](const MatrixEntry* a, const MatrixEntry* b) {
       return std::make_pair(a->where.line, a->where.column) < std::make_pair(b->where.line, b->where.column);
@@ -516,9 +517,12 @@ class Settings {
 
 void check_keys(const MatrixSection& sec) {
   for (const auto& e : sec.entries) {
-    if (e.key.rfind("param.", 0) == 0) {
+    if (e.key.rfind("param.", 0) == 0 || e.key.rfind("problem_param.", 0) == 0) {
       const size_t dots = std::count(e.key.begin(), e.key.end(), '.');
-      if (dots > 2) throw MatrixError(e.where, "'" + e.key + "': write param.NAME or param.METHOD.NAME");
+      const std::string head = e.key.substr(0, e.key.find('.'));
+      const std::string owner = head == "param" ? "METHOD" : "PROBLEM";
+      if (dots > 2)
+        throw MatrixError(e.where, "'" + e.key + "': write " + head + ".NAME or " + head + "." + owner + ".NAME");
       continue;
     }
     if (sec.kind == "defaults" && e.key == "name")
@@ -526,7 +530,8 @@ void check_keys(const MatrixSection& sec) {
     const auto& known = known_keys();
     if (std::find(known.begin(), known.end(), e.key) == known.end())
       throw MatrixError(e.where, "unknown key '" + e.key + "'" + suggestion(e.key, known) +
-                                     "; known: " + join(known, ", ") + ", param.NAME, param.METHOD.NAME");
+                                     "; known: " + join(known, ", ") +
+                                     ", param.NAME, param.METHOD.NAME, problem_param.NAME, problem_param.PROBLEM.NAME");
   }
 }
 
@@ -537,12 +542,19 @@ struct TEnd {
 };
 
 struct ParamChoice {
-  std::string method;  // empty: any method declaring `name`
+  std::string owner;  // the method (param.) or problem (problem_param.) it is for; empty: any declaring `name`
   std::string name;
   std::vector<const MatrixValue*> values;
   SourceLocation where;
   bool used = false;
 };
+
+// "a=1;b=2", in the given order.
+std::string join_params(const std::vector<std::pair<std::string, std::string>>& params) {
+  std::string out;
+  for (const auto& [k, v] : params) out += (out.empty() ? "" : ";") + k + "=" + v;
+  return out;
+}
 
 double estimate_cost(const RunConfig& c, const IntegratorInfo& integ, int repeats) {
   double evals;
@@ -559,8 +571,7 @@ double estimate_cost(const RunConfig& c, const IntegratorInfo& integ, int repeat
 // before the default existed, so ids stay), "none" for an explicit 0, else
 // the number.
 std::string canonical_text(const RunConfig& c, int repeats, const std::string& timeout_text, double repeat_if_under) {
-  std::string params;
-  for (const auto& [k, v] : c.params) params += (params.empty() ? "" : ";") + k + "=" + v;
+  const std::string params = join_params(c.params);
   std::string times;
   for (double t : c.times) {
     if (!times.empty()) times += ',';
@@ -578,14 +589,20 @@ std::string canonical_text(const RunConfig& c, int repeats, const std::string& t
   // Only when set, so that the ids of unperturbed cases stay what they were.
   if (c.perturb > 0) s << "\nperturb=" << format_exact(c.perturb);
   if (c.max_steps != kDefaultMaxSteps) s << "\nmax_steps=" << format_exact(c.max_steps);
+  if (!c.problem_params.empty()) s << "\nproblem_params=" << join_params(c.problem_params);
   s << "\n";
   return s.str();
 }
 
 }  // namespace
 
+std::string CaseEntry::problem_label() const {
+  return problem_params.empty() ? problem : problem + "(" + problem_params + ")";
+}
+
 std::string CaseEntry::label() const {
-  std::string s = problem + " " + method + (formulation.empty() ? "" : "[" + formulation + "]") + " " + integrator +
+  std::string s = problem_label() + " " + method + (formulation.empty() ? "" : "[" + formulation + "]") + " " +
+                  integrator +
                   " " + setting + " t_end=" + format_short(t_end);
   if (!params.empty()) s += " " + params;
   if (repeats > 1) s += " x" + std::to_string(repeats);
@@ -618,7 +635,9 @@ struct SweepPlan {
   int observe_every = 1, repeats = 1;
   bool series = true, keep_series = false, work_precision = true, overlay = false;
   std::vector<double> perturbs;
-  std::vector<ParamChoice> params;
+  std::vector<ParamChoice> params, problem_params;
+  // The given problem parameters of the problem variant being expanded.
+  std::vector<std::pair<std::string, std::string>> given_problem_params;
   size_t not_applicable = 0, wrong_integrator = 0, wrong_integrator_own = 0;
 };
 
@@ -657,10 +676,13 @@ class Expander {
     read_step_settings(set, p);
     read_t_ends(set, p);
     read_run_settings(set, p);
-    read_param_choices(set, p);
+    p.params = read_param_choices(set, p, "param.");
+    p.problem_params = read_param_choices(set, p, "problem_param.");
     check_formulations(p);
-    for (const Problem* problem : p.problems)
-      for (const MethodInfo* method : p.methods) expand_pair(p, *problem, *method);
+    for (const Problem* registered : p.problems)
+      for_each_variant(p, *registered, [&](const Problem& problem) {
+        for (const MethodInfo* method : p.methods) expand_pair(p, problem, *method);
+      });
     finish_sweep(p, notes_before, cases_before, duplicates_before);
   }
 
@@ -857,20 +879,21 @@ class Expander {
     p.overlay = set.boolean("overlay", false);
   }
 
-  // Stage 8: the `param.NAME` and `param.METHOD.NAME` keys, in file order.
-  void read_param_choices(const Settings& set, SweepPlan& p) const {
-    for (const MatrixEntry* e : set.params()) {
+  // Stage 8: the `param.NAME` and `param.METHOD.NAME` keys (prefix "param."),
+  // or `problem_param.NAME` and `problem_param.PROBLEM.NAME`, in file order.
+  std::vector<ParamChoice> read_param_choices(const Settings& set, const SweepPlan& p,
+                                              const std::string& prefix) const {
+    std::vector<ParamChoice> out;
+    for (const MatrixEntry* e : set.params(prefix)) {
       ParamChoice pc;
-      const std::string rest = e->key.substr(6);
+      const std::string rest = e->key.substr(prefix.size());
       const size_t dot = rest.find('.');
-      if (dot == std::string::npos) {
-        pc.name = rest;
-      } else {
-        pc.method = rest.substr(0, dot);
-        pc.name = rest.substr(dot + 1);
-        if (std::none_of(catalog_.methods.begin(), catalog_.methods.end(),
-                         [&](const MethodInfo& m) { return m.name == pc.method; }) && !p.optional)
-          throw MatrixError(e->where, "'" + e->key + "': unknown method '" + pc.method + "'");
+      pc.name = rest.substr(dot == std::string::npos ? 0 : dot + 1);
+      if (dot != std::string::npos) {
+        pc.owner = rest.substr(0, dot);
+        if (!known_owner(prefix, pc.owner) && !p.optional)
+          throw MatrixError(e->where, "'" + e->key + "': unknown " + (prefix == "param." ? "method" : "problem") +
+                                          " '" + pc.owner + "'");
       }
       pc.where = e->where;
       if (e->value.kind == Kind::kArray) {
@@ -881,8 +904,39 @@ class Expander {
       }
       for (const auto* v : pc.values)
         if (v->kind != Kind::kNumber) throw MatrixError(v->where, e->key + ": expected a number");
-      p.params.push_back(std::move(pc));
+      out.push_back(std::move(pc));
     }
+    return out;
+  }
+
+  bool known_owner(const std::string& prefix, const std::string& owner) const {
+    if (prefix == "param.")
+      return std::any_of(catalog_.methods.begin(), catalog_.methods.end(),
+                         [&](const MethodInfo& m) { return m.name == owner; });
+    return std::any_of(catalog_.problems.begin(), catalog_.problems.end(),
+                       [&](const Problem* pr) { return pr->info().name == owner; });
+  }
+
+  // Stage 8a: each combination of the sweep's problem_param.* values that
+  // apply to `registered` (the problem itself when none do), checked
+  // against the problem's ranges.
+  template <class Body>
+  void for_each_variant(SweepPlan& p, const Problem& registered, const Body& body) {
+    const std::string& name = registered.info().name;
+    const std::vector<ParamChoice*> applying =
+        applying_choices(p.problem_params, registered.problem_params(), name, "problem '" + name + "'",
+                         "problem_param.", "problem '" + name + "'");
+    for_each_combination(applying, [&](const std::vector<std::pair<std::string, std::string>>& given) {
+      p.given_problem_params = given;
+      std::unique_ptr<Problem> variant;
+      try {
+        variant = problem_variant(registered, given);
+      } catch (const UsageError& e) {
+        throw MatrixError(applying.front()->where, e.what());
+      }
+      body(variant ? *variant : registered);
+    });
+    p.given_problem_params.clear();
   }
 
   // Stage 9: every formulation named belongs to one of the sweep's problems.
@@ -951,29 +1005,53 @@ class Expander {
   // Stage 10a: the sweep's param.* keys that apply to this method, their values within its bounds.
   static std::vector<ParamChoice*> applying_params(SweepPlan& p, const ProblemInfo& info, const MethodInfo& method,
                                                    const std::vector<ParamSpec>& specs) {
+    return applying_choices(p.params, specs, method.name, "method '" + method.name + "'", "param.",
+                            "method '" + method.name + "' on problem '" + info.name + "'");
+  }
+
+  // The choices that apply to `owner` (named by it, or unqualified and
+  // declared in `specs`), their values checked against the specs' ranges.
+  static std::vector<ParamChoice*> applying_choices(std::vector<ParamChoice>& choices,
+                                                    const std::vector<ParamSpec>& specs, const std::string& owner,
+                                                    const std::string& owner_text, const std::string& prefix,
+                                                    const std::string& context) {
     std::vector<ParamChoice*> applying;
-    for (auto& pc : p.params) {
-      if (!pc.method.empty() && pc.method != method.name) continue;
+    for (auto& pc : choices) {
+      if (!pc.owner.empty() && pc.owner != owner) continue;
       const auto spec = std::find_if(specs.begin(), specs.end(), [&](const ParamSpec& s) { return s.name == pc.name; });
       if (spec == specs.end()) {
-        if (!pc.method.empty()) {
+        if (!pc.owner.empty()) {
           std::vector<std::string> known;
-          for (const auto& s : specs) known.push_back(s.name);
-          throw MatrixError(pc.where, "method '" + method.name + "' has no parameter '" + pc.name +
-                                          "' on problem '" + info.name + "' (known: " + join(known, ", ") + ")");
+          for (const auto& s : specs) known.push_back(s.name + " (" + bound_text(s) + ")");
+          throw MatrixError(pc.where, context + " has no parameter '" + pc.name + "' (known: " +
+                                          (known.empty() ? "none" : join(known, ", ")) + ")");
         }
         continue;
       }
       for (const auto* v : pc.values) {
         const std::string problem = param_value_problem(*spec, v->number);
         if (!problem.empty())
-          throw MatrixError(v->where, "param." + pc.name + " = " + v->text + ": " + problem + " for method '" +
-                                          method.name + "'");
+          throw MatrixError(v->where, prefix + pc.name + " = " + v->text + ": " + problem + " for " + owner_text);
       }
       pc.used = true;
       applying.push_back(&pc);
     }
     return applying;
+  }
+
+  // Calls body(values) for every combination of the choices' values (once, with none, for no choices).
+  template <class Body>
+  static void for_each_combination(const std::vector<ParamChoice*>& choices, const Body& body) {
+    std::vector<size_t> pick(choices.size(), 0);
+    while (true) {
+      std::vector<std::pair<std::string, std::string>> values;
+      for (size_t i = 0; i < choices.size(); ++i)
+        values.emplace_back(choices[i]->name, format_short(choices[i]->values[pick[i]]->number));
+      body(values);
+      size_t i = 0;
+      while (i < pick.size() && ++pick[i] == choices[i]->values.size()) pick[i++] = 0;
+      if (i == pick.size()) break;
+    }
   }
 
   // Stage 10b: the case budget (a bound of what this pair adds), checked before any case is built.
@@ -1021,17 +1099,10 @@ class Expander {
       for (const auto* r : p.rtols)
         for (const auto* a : p.atols) settings.push_back({0, r->number, a->number});
     }
-    std::vector<size_t> pick(applying.size(), 0);
-    while (true) {
-      std::vector<std::pair<std::string, std::string>> params;
-      for (size_t i = 0; i < applying.size(); ++i)
-        params.emplace_back(applying[i]->name, format_short(applying[i]->values[pick[i]]->number));
+    for_each_combination(applying, [&](const std::vector<std::pair<std::string, std::string>>& params) {
       for (const StepSettings& st : settings)
         for (const double perturb : p.perturbs) add_case(p, info, method, form, integ, t_end, params, st, perturb);
-      size_t i = 0;
-      while (i < pick.size() && ++pick[i] == applying[i]->values.size()) pick[i++] = 0;
-      if (i == pick.size()) break;
-    }
+    });
   }
 
   // Stage 12: one case, unless an identical one is already in the expansion.
@@ -1041,6 +1112,7 @@ class Expander {
     MatrixCase c;
     RunConfig& cfg = c.config;
     cfg.problem = info.name;
+    cfg.problem_params = p.given_problem_params;
     cfg.method = method.name;
     cfg.formulation = form;
     cfg.integrator = integ.name;
@@ -1068,10 +1140,11 @@ class Expander {
     e.index = out_.cases.size();
     e.sweep = p.name;
     e.problem = cfg.problem;
+    e.problem_params = join_params(cfg.problem_params);
     e.method = cfg.method;
     e.formulation = form;
     e.integrator = cfg.integrator;
-    for (const auto& [k, v] : cfg.params) e.params += (e.params.empty() ? "" : ";") + k + "=" + v;
+    e.params = join_params(cfg.params);
     if (integ.fixed_step)
       e.setting = "step=" + format_short(st.step);
     else if (st.rtol == st.atol)
@@ -1084,7 +1157,8 @@ class Expander {
     e.work_precision = p.work_precision;
     e.overlay = p.overlay;
     e.curve = e.method + (form.empty() ? "" : "[" + form + "]") + "/" + e.integrator +
-              (e.params.empty() ? "" : " " + e.params);
+              (e.params.empty() ? "" : " " + e.params) +
+              (e.problem_params.empty() ? "" : " (" + e.problem_params + ")");
     c.cost_estimate = estimate_cost(cfg, integ, p.repeats);
     out_.cases.push_back(std::move(c));
   }
@@ -1093,8 +1167,12 @@ class Expander {
   void finish_sweep(const SweepPlan& p, size_t notes_before, size_t cases_before, size_t duplicates_before) {
     for (const auto& pc : p.params)
       if (!pc.used && !p.optional)
-        note(p, "param." + (pc.method.empty() ? "" : pc.method + ".") + pc.name + " (line " +
+        note(p, "param." + (pc.owner.empty() ? "" : pc.owner + ".") + pc.name + " (line " +
                     std::to_string(pc.where.line) + ") applies to no method of the sweep");
+    for (const auto& pc : p.problem_params)
+      if (!pc.used && !p.optional)
+        note(p, "problem_param." + (pc.owner.empty() ? "" : pc.owner + ".") + pc.name + " (line " +
+                    std::to_string(pc.where.line) + ") applies to no problem of the sweep");
     if (p.wrong_integrator)
       note(p, std::to_string(p.wrong_integrator) + " method x integrator combinations skipped: DAE methods (ida-*) "
               "need integrator 'ida', and 'ida' needs a DAE method");

@@ -17,6 +17,7 @@
 //     step = [1e-2, 1e-3, 1e-4]         # fixed-step integrators
 //     t_end = "ref"                     # number | "ref" | "default"
 //     param.lambda = [100, 1500]        # only for methods declaring it
+//     problem_param.length = [1, 2]     # only for problems declaring it
 //
 // Expansion is deterministic (file order, then the order of every array,
 // problems/methods in registry order for "all"). A case's id is a hash of
@@ -104,6 +105,7 @@ struct CaseEntry {
   std::string id;           // 16 hex digits
   std::string sweep;        // name of the [[sweep]] it came from
   std::string problem, method, formulation, integrator;
+  std::string problem_params;  // given problem parameters, "a=1;b=2" (defaults not listed)
   std::string params;       // given parameters, "a=1;b=2" (defaults not listed)
   std::string setting;      // "step=0.001" or "tol=1e-08" or "rtol=..;atol=.."
   double t_end = 0;
@@ -112,6 +114,7 @@ struct CaseEntry {
   bool overlay = false;        // candidate for the per-method time-series overlays
   std::string curve;           // work-precision curve: method/integrator[ params]
   std::string label() const;   // one line for progress output
+  std::string problem_label() const;  // "pendulum(length=2)", or the name alone
 };
 
 // The timeout of a case whose matrix gives none (key `timeout`): 600 s, far

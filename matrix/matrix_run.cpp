@@ -65,6 +65,7 @@ Row failure_row(const MatrixCase& c, Status status, const std::string& reason) {
   row.emplace_back("case_id", c.entry.id);
   row.emplace_back("repeat", "0");
   row.emplace_back("problem", cfg.problem);
+  row.emplace_back("problem_params", c.entry.problem_params);
   row.emplace_back("formulation", cfg.formulation);
   row.emplace_back("method", cfg.method);
   row.emplace_back("params", c.entry.params);
@@ -325,6 +326,8 @@ void compute_references(const std::vector<const MatrixCase*>& todo, const Matrix
     if (g_stop_signal) break;
     const Problem& p = opt.find_problem(c->config.problem);
     const double t = c->config.ref_time < 0 ? p.info().reference_time : c->config.ref_time;
+    // A problem variant (problem_params) computes its own reference in the worker.
+    if (!c->config.problem_params.empty()) continue;
     if (!(t > 0) || t > c->config.t_end || !done.insert({c->config.problem, t}).second) continue;
     std::vector<double> buf(p.info().coordinates.size());
     p.reference(t, buf.data());
@@ -645,6 +648,7 @@ void write_manifest(const std::string& path, const std::vector<CaseEntry>& entri
                     {"case_id", e.id},
                     {"sweep", e.sweep},
                     {"problem", e.problem},
+                    {"problem_params", e.problem_params},
                     {"method", e.method},
                     {"formulation", e.formulation},
                     {"integrator", e.integrator},
@@ -659,7 +663,8 @@ void write_manifest(const std::string& path, const std::vector<CaseEntry>& entri
   }
   if (rows.empty())
     write_file_atomic(path,
-                      "index,case_id,sweep,problem,method,formulation,integrator,params,setting,t_end,repeats,"
+                      "index,case_id,sweep,problem,problem_params,method,formulation,integrator,params,setting,t_end,"
+                      "repeats,"
                       "work_precision,overlay,curve,selected_cases\n");
   else
     write_file_atomic(path, rows_to_csv(rows));
@@ -702,6 +707,7 @@ std::vector<CaseEntry> read_manifest(const std::string& path, size_t* selected_c
       throw UsageError(t.where(i, "case_id") + ": case_id: '" + e.id + "' is not a case id (16 hex digits)");
     e.sweep = t.get(i, "sweep");
     e.problem = t.get(i, "problem");
+    e.problem_params = t.get(i, "problem_params");  // absent in folders written before problem parameters
     e.method = t.get(i, "method");
     e.formulation = t.get(i, "formulation");
     e.integrator = t.get(i, "integrator");

@@ -246,11 +246,21 @@ inline constexpr bool reference_exact = requires(const P& p, double t, double* c
   { p.reference(t, c) } -> std::convertible_to<bool>;
 };
 
+// Problem parameters: both functions or neither.
+template <class P>
+inline constexpr bool problem_params_exact = requires(const P& p, const Params& params) {
+  { p.problem_params() } -> std::same_as<std::vector<ParamSpec>>;
+  { p.with_params(params) } -> std::same_as<P>;
+};
+template <class P>
+inline constexpr bool problem_params_ok =
+    problem_params_exact<P> || (!names_problem_params<P> && !names_with_params<P>);
+
 template <class P>
 inline constexpr bool problem_ok = info_ok<P> && mechanical_accessor_ok<P>() && state_space_accessor_ok<P>() &&
                                    minimal_accessor_ok<P>() && (energy_exact<P> || !names_energy<P>) &&
                                    (first_integrals_exact<P> || !names_first_integrals<P>) &&
-                                   (reference_exact<P> || !names_reference<P>);
+                                   (reference_exact<P> || !names_reference<P>) && problem_params_ok<P>;
 
 }  // namespace detail
 
@@ -272,6 +282,8 @@ template <class P>
 concept HasFirstIntegrals = detail::first_integrals_exact<P>;
 template <class P>
 concept HasReference = detail::reference_exact<P>;
+template <class P>
+concept HasProblemParams = detail::problem_params_exact<P>;
 
 // ---------------------------------------------------------------- method
 namespace detail {
@@ -481,6 +493,9 @@ constexpr bool check_problem() {
   static_assert(detail::reference_exact<P> || !detail::names_reference<P>,
                 "cstab contract: problem declares reference, but not as `bool reference(double t, double* "
                 "canonical) const` (wrong signature or not const)");
+  static_assert(detail::problem_params_ok<P>,
+                "cstab contract: problem parameters need both `std::vector<ParamSpec> problem_params() const` and "
+                "`P with_params(const Params& params) const` (the problem with those values)");
   return true;
 }
 

@@ -71,6 +71,16 @@ class ProblemAdapter final : public Problem {
     return false;
   }
 
+  std::vector<ParamSpec> problem_params() const override {
+    if constexpr (contracts::HasProblemParams<P>) return p_.problem_params();
+    return {};
+  }
+  std::unique_ptr<Problem> with_params(const Params& params) const override {
+    if constexpr (contracts::HasProblemParams<P>)
+      return std::make_unique<ProblemAdapter<P>>(p_.with_params(params), pairs_);
+    return nullptr;
+  }
+
   const P& concrete() const { return p_; }
 
  private:

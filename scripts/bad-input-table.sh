@@ -48,6 +48,8 @@ w no_step '[[sweep]]\nproblems = ["wheel"]\nmethods = ["pesterev"]\nintegrators 
 w param_negative '[[sweep]]\nproblems = ["wheel"]\nmethods = ["pesterev"]\nintegrators = "rk4"\nstep = 1e-3\nt_end = 0.05\nparam.lambda = -5\n'
 w param_string '[[sweep]]\nproblems = ["wheel"]\nmethods = ["pesterev"]\nintegrators = "rk4"\nstep = 1e-3\nt_end = 0.05\nparam.lambda = "big"\n'
 w param_unknown_method '[[sweep]]\nproblems = ["wheel"]\nmethods = ["pesterev"]\nintegrators = "rk4"\nstep = 1e-3\nt_end = 0.05\nparam.pesterv.lambda = 5\n'
+w problem_param_range '[[sweep]]\nproblems = ["pendulum"]\nmethods = ["projection"]\nintegrators = "rk4"\nstep = 1e-3\nt_end = 0.05\nproblem_param.length = [1, -2]\n'
+w problem_param_unknown '[[sweep]]\nproblems = ["pendulum"]\nmethods = ["projection"]\nintegrators = "rk4"\nstep = 1e-3\nt_end = 0.05\nproblem_param.pendulum.N = 4\n'
 w param_unknown_name '[[sweep]]\nproblems = ["wheel"]\nmethods = ["pesterev"]\nintegrators = "rk4"\nstep = 1e-3\nt_end = 0.05\nparam.pesterev.lamda = 5\n'
 w unknown_problem '[[sweep]]\nproblems = ["whel"]\nmethods = ["pesterev"]\nintegrators = "rk4"\nstep = 1e-3\nt_end = 0.05\n'
 w unknown_method '[[sweep]]\nproblems = ["wheel"]\nmethods = ["pesterv"]\nintegrators = "rk4"\nstep = 1e-3\nt_end = 0.05\n'
@@ -113,6 +115,12 @@ cases=(
 "run_param_twice|run $G --param lambda=1 --param lambda=2 --out OUT"
 "run_param_no_eq|run $G --param lambda --out OUT"
 "run_param_for_none|run ${G/pesterev/none} --param lambda=1 --out OUT"
+"run_problem_param_unknown|run $G --problem-param N=3 --out OUT"
+"run_problem_param_range|run ${G/wheel/pendulum} --problem-param length=0 --out OUT"
+"run_problem_param_nan|run ${G/wheel/pendulum} --problem-param angle=nan --out OUT"
+"run_problem_param_word|run ${G/wheel/pendulum} --problem-param length=long --out OUT"
+"run_problem_param_twice|run ${G/wheel/pendulum} --problem-param length=1 --problem-param length=2 --out OUT"
+"run_problem_param_no_eq|run ${G/wheel/pendulum} --problem-param length --out OUT"
 "run_times_beyond|run $G --times 1 --out OUT"
 "run_times_zero|run $G --times 0 --out OUT"
 "run_times_garbage|run $G --times 0.01,,0.02 --out OUT"

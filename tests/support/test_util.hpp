@@ -14,8 +14,41 @@
 #include <vector>
 
 #include "matrix/matrix.hpp"
+#include "methods/pair.hpp"
+#include "problems/registry.hpp"
 
 namespace cstab::testing {
+
+// The registries as a matrix catalog.
+inline MatrixCatalog registry_catalog() {
+  MatrixCatalog c;
+  for (const auto& p : all_problems()) c.problems.push_back(p.get());
+  c.methods = all_methods();
+  return c;
+}
+
+// The message of the MatrixError that parsing + expanding `text` (as m.toml) throws; "(no error)" if none.
+inline std::string matrix_error_of(const std::string& text) {
+  try {
+    expand_matrix(parse_matrix(text, "m.toml"), registry_catalog());
+  } catch (const MatrixError& e) {
+    return e.what();
+  }
+  return "(no error)";
+}
+
+// One run without series: `problem` x `method` on `integrator` with `step` over [0, t_end].
+inline RunConfig quiet_run_config(const std::string& problem, const std::string& method, const std::string& integrator,
+                                  StepSettings step, double t_end) {
+  RunConfig c;
+  c.problem = problem;
+  c.method = method;
+  c.integrator = integrator;
+  c.step = step;
+  c.t_end = t_end;
+  c.write_series = false;
+  return c;
+}
 
 // Single-quoted for /bin/sh.
 inline std::string quote(const std::string& s) {

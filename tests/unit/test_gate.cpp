@@ -59,7 +59,7 @@ TEST(GateThresholds, CommittedFileParsesAndRoundTripsVerbatim) {
   EXPECT_GE(f.rows.size(), 50u);
   std::map<std::string, int> per_problem;
   for (const auto& r : f.rows) ++per_problem[r.problem];
-  for (const char* p : {"wheel", "ball", "biped", "slider-crank", "andrews", "car-axis"})
+  for (const char* p : {"wheel", "ball", "biped", "slider-crank", "andrews", "car-axis", "pendulum"})
     EXPECT_GE(per_problem[p], 5) << p;
   // Rewriting without changes reproduces the file (comments included).
   EXPECT_EQ(cstab::thresholds_text(f), text);

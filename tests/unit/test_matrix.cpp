@@ -29,22 +29,9 @@ namespace {
 
 namespace fs = std::filesystem;
 
-MatrixCatalog registry_catalog() {
-  MatrixCatalog c;
-  for (const auto& p : all_problems()) c.problems.push_back(p.get());
-  c.methods = all_methods();
-  return c;
-}
-
+using testing::registry_catalog;
 // The message of the MatrixError that parsing + expanding `text` throws.
-std::string error_of(const std::string& text) {
-  try {
-    expand_matrix(parse_matrix(text, "m.toml"), registry_catalog());
-  } catch (const MatrixError& e) {
-    return e.what();
-  }
-  return "(no error)";
-}
+std::string error_of(const std::string& text) { return testing::matrix_error_of(text); }
 
 const char* kSweepHead = "[[sweep]]\nproblems = [\"wheel\"]\nmethods = [\"pesterev\", \"minimal\"]\n";
 

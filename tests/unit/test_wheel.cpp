@@ -18,6 +18,7 @@
 #include "methods/affine.hpp"
 #include "methods/minimal.hpp"
 #include "methods/pesterev.hpp"
+#include "tests/support/test_util.hpp"
 #include "problems/registry.hpp"
 #include "problems/wheel/wheel.hpp"
 #include "tests/support/expect_close.hpp"
@@ -361,14 +362,7 @@ TEST(WheelLambdaFeedback, BadLambdaNeverReachesTheFormulation) {
 // Against the independent minimal-coordinate model (regression)
 
 RunConfig wheel_config(const std::string& method, const std::string& integrator, StepSettings s, double t_end) {
-  RunConfig c;
-  c.problem = "wheel";
-  c.method = method;
-  c.integrator = integrator;
-  c.step = s;
-  c.t_end = t_end;
-  c.write_series = false;
-  return c;
+  return testing::quiet_run_config("wheel", method, integrator, s, t_end);
 }
 
 TEST(WheelRegression, PesterevMatchesMinimalModel) {
