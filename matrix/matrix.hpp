@@ -196,16 +196,19 @@ struct MatrixRunStats {
 MatrixRunStats run_matrix(const std::vector<MatrixCase>& cases, const MatrixRunOptions& options,
                           std::ostream& log, bool log_is_tty);
 
-// Drops the series of the finished cases in `cases` that neither keep them
-// (keep_series) nor are in `used` (the cases the report's pictures read).
-// Each stays cached: its key.txt no longer lists the series and says
-// `dropped series.csv.gz`. Returns how many were dropped and their bytes.
-struct DroppedSeries {
-  size_t cases = 0;
-  unsigned long long bytes = 0;
+// After the report, the series of the finished cases in `cases` that do
+// not keep them (keep_series): one no picture reads (not in `used`) is
+// dropped (key.txt no longer lists it and says `dropped series.csv.gz`),
+// one a picture reads is rounded to plot precision (csv_at_plot_precision;
+// key.txt records the new file and says `rounded series.csv.gz`), which
+// redraws the same pictures. Either way the case stays cached unless
+// keep_series later asks for its exact series.
+struct SeriesShrunk {
+  size_t dropped = 0, rounded = 0;
+  unsigned long long dropped_bytes = 0, rounded_bytes_saved = 0;
 };
-DroppedSeries drop_unused_series(const std::string& out_dir, const std::vector<MatrixCase>& cases,
-                                 const std::set<std::string>& used);
+SeriesShrunk shrink_series(const std::string& out_dir, const std::vector<MatrixCase>& cases,
+                           const std::set<std::string>& used);
 // "SIGINT", "SIGTERM", "SIGHUP" (for messages about `interrupted_by`).
 std::string stop_signal_name(int sig);
 

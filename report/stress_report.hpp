@@ -30,7 +30,7 @@ namespace cstab {
 struct StressPlot {
   std::string name;     // basename under DIR/plots
   std::string script;   // gnuplot script in plots/
-  std::string data;     // contents of DIR/plots/data/<name>.dat
+  std::string data;     // contents of DIR/plots/data/<name>.dat(.gz)
   std::string vars;     // extra gnuplot -e assignments ("; a=...")
   std::string caption;
 };
