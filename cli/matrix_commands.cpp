@@ -185,17 +185,17 @@ std::string one_decimal(double v) {
   return text;
 }
 
-// After the report: the series no picture reads go, the others are rounded
-// to plot precision (each case stays cached), unless the case keeps them
-// (keep_series, --keep-series).
+// After the report: the series no picture reads go, the others are cut to
+// the columns the pictures read at plot precision (each case stays cached),
+// unless the case keeps them (keep_series, --keep-series).
 void shrink_series_after(const std::string& out, const std::vector<MatrixCase>& cases, const ReportResult& report) {
   const SeriesShrunk d = shrink_series(out, cases, report.series_used);
   if (d.dropped)
     std::cout << "matrix: kept the series the pictures read; dropped " << d.dropped << " others ("
               << one_decimal(double(d.dropped_bytes) / 1e6) << " MB; --keep-series or keep_series = true keeps them)\n";
-  if (d.rounded)
-    std::cout << "matrix: rounded the " << d.rounded << " series the pictures read to their 7 digits ("
-              << one_decimal(double(d.rounded_bytes_saved) / 1e6) << " MB less; --keep-series keeps them exact)\n";
+  if (d.reduced)
+    std::cout << "matrix: cut the " << d.reduced << " series the pictures read to their columns and 7 digits ("
+              << one_decimal(double(d.reduced_bytes_saved) / 1e6) << " MB less; --keep-series keeps them whole)\n";
 }
 
 // Outcomes over the whole folder, cached cases included: "3 ok, 1 diverged".
@@ -257,8 +257,8 @@ void declare_matrix(Args& a) {
       .flag("--force", "rerun cases even if their results are in DIR")
       .flag("--no-report", "do not build the report after the run (every series is then kept)");
   declare_svg(a);
-  a.flag("--keep-series", "keep every case's series, exact (as matrix key keep_series = true); by default "
-                          "only the series the report's pictures read are kept, rounded to their 7 digits")
+  a.flag("--keep-series", "keep every case's series whole (as matrix key keep_series = true); by default only "
+                          "the series the report's pictures read are kept, cut to their columns and 7 digits")
       .flag("--list", "print the cases (index, id, sweep, label) and exit; no --out needed")
       .flag("--print-default", "print the embedded default matrix and exit");
 }

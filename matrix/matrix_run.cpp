@@ -115,9 +115,9 @@ void write_result(const std::string& dir, const std::vector<Row>& rows, const st
 
 // Why the cached result in `dir` cannot be reused for `key` ("" if it can):
 // key.txt must hold this configuration and binary, then list every result
-// file with the size and hash it has now. A series dropped or rounded by an
-// earlier run (`dropped NAME`, `rounded NAME`: shrink_series) is fine unless
-// `need_series`.
+// file with the size and hash it has now. A series dropped or cut by an
+// earlier run (`dropped NAME`, `for-pictures NAME`: shrink_series) is fine
+// unless `need_series`.
 std::string cache_problem(const std::string& dir, const std::string& key, bool need_series) {
   std::string text;
   try {
@@ -133,11 +133,11 @@ std::string cache_problem(const std::string& dir, const std::string& key, bool n
     std::istringstream words(line);
     std::string tag, name, hash;
     unsigned long long size = 0;
-    if (line.rfind("dropped ", 0) == 0 || line.rfind("rounded ", 0) == 0) {
+    if (line.rfind("dropped ", 0) == 0 || line.rfind("for-pictures ", 0) == 0) {
       if (need_series)
         return line[0] == 'd' ? "its series was dropped by an earlier run (keep_series asks for it)"
-                              : "its series was rounded to plot precision by an earlier run (keep_series asks "
-                                "for the exact one)";
+                              : "its series was cut to the pictures' columns and 7 digits by an earlier run "
+                                "(keep_series asks for the whole one)";
       continue;
     }
     if (!(words >> tag >> name >> size >> hash) || tag != "file") return "key.txt: malformed line '" + line + "'";
@@ -895,40 +895,41 @@ bool drop_series_file(const std::string& dir, const std::string& name) {
   return true;
 }
 
-// Rounds series.csv.gz to plot precision (csv_at_plot_precision): the file
-// first, then key.txt with its new size and hash and `rounded NAME`; a crash
-// between the two leaves a file whose hash key.txt does not match, so the
-// case runs again. Returns the bytes saved; 0 if already rounded.
-unsigned long long round_series_file(const std::string& dir) {
+// Cuts series.csv.gz to the `columns` the pictures read, at plot precision:
+// the file first, then key.txt with its new size and hash and
+// `for-pictures NAME`; a crash between the two leaves a file whose hash
+// key.txt does not match, so the case runs again. Returns the bytes saved;
+// 0 if it was cut before.
+unsigned long long cut_series_file(const std::string& dir, const std::set<std::string>& columns) {
   const std::string name = "series.csv.gz", path = dir + "/" + name;
-  std::string exact;
+  std::string whole;
   try {
-    if (read_text_file(dir + "/key.txt").find("\nrounded " + name + "\n") != std::string::npos) return 0;
-    exact = read_text_file(path);
+    if (read_text_file(dir + "/key.txt").find("\nfor-pictures " + name + "\n") != std::string::npos) return 0;
+    whole = read_text_file(path);
   } catch (const std::exception&) {
     return 0;  // unfinished or missing: the cache check deals with it
   }
-  const std::string rounded = gzip_compress(csv_at_plot_precision(gzip_decompress(exact, kMaxInputFileBytes)));
-  const std::string line = "file " + name + " " + std::to_string(rounded.size()) + " " + hash_hex(rounded) + "\n";
-  const std::string key = key_with(dir, name, line + "rounded " + name + "\n");
-  if (key.empty() || rounded.size() >= exact.size()) return 0;
-  write_file_atomic(path, rounded);
+  const std::string csv = gzip_decompress(whole, kMaxInputFileBytes);
+  const std::string cut = gzip_compress(csv_at_plot_precision(csv_select_columns(csv, columns)));
+  const std::string line = "file " + name + " " + std::to_string(cut.size()) + " " + hash_hex(cut) + "\n";
+  const std::string key = key_with(dir, name, line + "for-pictures " + name + "\n");
+  if (key.empty() || cut.size() >= whole.size()) return 0;
+  write_file_atomic(path, cut);
   write_file_atomic(dir + "/key.txt", key);
-  return exact.size() - rounded.size();
+  return whole.size() - cut.size();
 }
 
 }  // namespace
 
-SeriesShrunk shrink_series(const std::string& out_dir, const std::vector<MatrixCase>& cases,
-                           const std::set<std::string>& used) {
+SeriesShrunk shrink_series(const std::string& out_dir, const std::vector<MatrixCase>& cases, const SeriesUse& used) {
   SeriesShrunk done;
   for (const auto& c : cases) {
     if (c.keep_series) continue;
     const std::string dir = case_folder(out_dir, c.entry.id);
-    if (used.count(c.entry.id)) {
-      const unsigned long long saved = round_series_file(dir);
-      done.rounded += saved > 0;
-      done.rounded_bytes_saved += saved;
+    if (const auto it = used.find(c.entry.id); it != used.end()) {
+      const unsigned long long saved = cut_series_file(dir, it->second);
+      done.reduced += saved > 0;
+      done.reduced_bytes_saved += saved;
       continue;
     }
     for (const char* name : {"series.csv.gz", "series.csv"}) {

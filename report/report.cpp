@@ -211,15 +211,24 @@ double cell(const std::vector<std::string>& row, int col) {
 // A case's series (series.csv.gz or series.csv); empty if it is missing or unreadable.
 CsvTable read_series(const std::string& dir, const CaseResult& c) { return load_case_series(dir, *c.entry); }
 
-// Overlay data: per run, t, max |residual|, |drift|. Colours in `lcs`.
+// Records that the pictures read columns `cols` of case `c`'s series `s`.
+void note_use(SeriesUse& used, const CaseResult& c, const CsvTable& s, const std::vector<int>& cols) {
+  for (int col : cols) used[c.entry->id].insert(s.header[col]);
+}
+
+// Overlay data: per run, t, max |residual|, |drift|. Colours in `lcs`; the
+// columns read in `used`.
 std::string overlay_data(const std::string& dir, const std::vector<const CaseResult*>& runs,
-                         const std::map<std::string, int>& colour, std::string& lcs, bool& has_drift) {
+                         const std::map<std::string, int>& colour, std::string& lcs, bool& has_drift,
+                         SeriesUse& used) {
   std::string out;
   has_drift = false;
   for (const CaseResult* c : runs) {
     const CsvTable s = read_series(dir, *c);
     if (s.rows.empty()) continue;  // missing or unreadable: the run is left out
     const SeriesColumns cols = classify(s);
+    note_use(used, *c, s, cols.residuals);
+    note_use(used, *c, s, cols.drifts);
     has_drift = has_drift || !cols.drifts.empty();
     if (!out.empty()) out += "\n\n";
     out += quoted_header(run_label(*c), {"max_abs_residual", "abs_drift"});
@@ -235,10 +244,11 @@ std::string overlay_data(const std::string& dir, const std::vector<const CaseRes
 }
 
 // Trajectory data: per run, t and the position coordinates (names not
-// ending in "dot"; at most 9). Colours in `lcs`, coordinate names in `names`.
+// ending in "dot"; at most 9). Colours in `lcs`, coordinate names in
+// `names`, the columns read in `used`.
 std::string trajectory_data(const std::string& dir, const std::vector<const CaseResult*>& runs,
                             const std::map<std::string, int>& colour, std::string& lcs,
-                            std::vector<std::string>& names) {
+                            std::vector<std::string>& names, SeriesUse& used) {
   std::string out;
   for (const CaseResult* c : runs) {
     const CsvTable s = read_series(dir, *c);
@@ -251,6 +261,7 @@ std::string trajectory_data(const std::string& dir, const std::vector<const Case
     }
     if (shown.empty()) shown = cols.coords;
     if (shown.size() > 9) shown.resize(9);
+    note_use(used, *c, s, shown);
     std::vector<std::string> these;
     for (int col : shown) these.push_back(s.header[col]);
     if (out.empty()) names = these;
@@ -462,7 +473,7 @@ struct PlotSet {
   std::string plot_dir;
   std::vector<PlotJob> jobs;
   std::map<std::string, std::string> captions;
-  std::set<std::string> series_used;  // case ids whose series the pictures read
+  SeriesUse series_used;  // the series the pictures read: case id -> columns
   // Writes plots/data/<name>.dat.gz (gzip, read by the scripts through
   // gzip -dc; style.gp) and queues the job; returns the name.
   std::string add(const std::string& name, const std::string& script, const std::string& data,
@@ -554,8 +565,8 @@ void add_overlay_plot(PlotSet& plots, const std::string& dir, ProblemView& p, co
                       const std::vector<const CaseResult*>& overlay) {
   std::string lcs;
   bool has_drift = false;
-  const std::string text = overlay_data(dir, overlay, style.colour, lcs, has_drift);
-  for (const CaseResult* c : overlay) plots.series_used.insert(c->entry->id);
+  for (const CaseResult* c : overlay) plots.series_used[c->entry->id];  // kept even if unread
+  const std::string text = overlay_data(dir, overlay, style.colour, lcs, has_drift, plots.series_used);
   if (text.empty()) return;
   std::string who;
   for (const CaseResult* c : overlay) who += (who.empty() ? "" : "; ") + run_label(*c);
@@ -575,8 +586,8 @@ void add_trajectory_plot(PlotSet& plots, const std::string& dir, ProblemView& p,
   std::string lcs;
   std::vector<std::string> names;
   const auto trajectory = trajectory_runs(dir, p, overlay);
-  const std::string text = trajectory_data(dir, trajectory, style.colour, lcs, names);
-  for (const CaseResult* c : trajectory) plots.series_used.insert(c->entry->id);
+  for (const CaseResult* c : trajectory) plots.series_used[c->entry->id];  // kept even if unread
+  const std::string text = trajectory_data(dir, trajectory, style.colour, lcs, names, plots.series_used);
   if (text.empty()) return;
   std::string joined, who;
   for (const auto& n : names) joined += (joined.empty() ? "" : " ") + n;
@@ -927,7 +938,7 @@ ReportResult build_report(const std::string& dir, const ReportOptions& opt, std:
   write_replot_script(plots, scripts);
   if (opt.plots) draw_plots(plots, scripts, opt, result);
   result.series_used = plots.series_used;
-  result.series_used.insert(stress.series_used.begin(), stress.series_used.end());
+  for (const auto& [id, columns] : stress.series_used) result.series_used[id].insert(columns.begin(), columns.end());
   // report.html.
   const Provenance prov = parse_provenance(file_or_empty(dir + "/provenance.txt"));
   const Page page{dir, folder.cases, problems, stress, stress_plots, plots, prov, result.warnings};

@@ -28,6 +28,8 @@
 #include <string>
 #include <vector>
 
+#include "matrix/matrix.hpp"
+
 namespace cstab {
 
 struct ReportOptions {
@@ -42,8 +44,9 @@ struct ReportResult {
   size_t plots_drawn = 0, plots_reused = 0;
   std::vector<std::string> warnings;
   // The cases whose series the pictures read (overlays, trajectories, long
-  // horizons): what `cstab matrix` keeps when it drops the other series.
-  std::set<std::string> series_used;
+  // horizons), each with the columns read: what `cstab matrix` keeps when
+  // it drops the other series (shrink_series).
+  SeriesUse series_used;
 };
 
 // Needs DIR/summary.csv (write_matrix_summary). A picture whose data and

@@ -326,7 +326,17 @@ TEST(ReportText, EscapersQuotersAndCells) {
   EXPECT_EQ(cstab::url_path_escape("stress_a b#1?%\"<"), "stress_a%20b%231%3F%25%22%3C");
 }
 
-// A series kept for the pictures is rounded to plot precision: numbers to
+// A series kept for the pictures holds the columns they read (the first
+// always), in order; a row's missing cells stay missing.
+TEST(ReportText, CsvSelectColumnsKeepsTheFirstAndTheNamedOnes) {
+  const std::string csv = "t,x,xdot,residual_a,cond\n0,1,2,3,4\n0.5,1.5,,3.5\n1\n";
+  EXPECT_EQ(cstab::csv_select_columns(csv, {"residual_a", "x", "nope"}), "t,x,residual_a\n0,1,3\n0.5,1.5,3.5\n1\n");
+  EXPECT_EQ(cstab::csv_select_columns(csv, {"xdot"}), "t,xdot\n0,2\n0.5,\n1\n");
+  EXPECT_EQ(cstab::csv_select_columns(csv, {}), csv);
+  EXPECT_EQ(cstab::csv_select_columns("t,x\n,7", {"x"}), "t,x\n,7");  // an empty first cell; no final newline
+}
+
+// ... and its numbers at plot precision: numbers to
 // 7 digits, everything else and the header as they were; the pictures'
 // cells of the rounded numbers are those of the exact ones.
 TEST(ReportText, CsvAtPlotPrecisionRoundsOnlyTheNumbersOfTheRows) {
