@@ -68,7 +68,8 @@ optional = true
 
 # SUNDIALS ODE integrators (docs/methods.md): ARKODE's explicit Fehlberg 8(7)
 # on every method, CVODE's BDF on the methods without a post-step (a
-# projection restarts it at order 1 after every step).
+# projection restarts it at order 1 after every step), the penalty
+# formulation among them.
 [[sweep]]
 name = "wp-ark-erk"
 integrators = ["ark-erk-fehlberg8"]
@@ -77,7 +78,7 @@ param.braun-goldfarb.dt = 1e-3
 
 [[sweep]]
 name = "wp-cvode-bdf"
-methods = ["pesterev", "baumgarte", "none", "minimal"]
+methods = ["pesterev", "baumgarte", "penalty", "none", "minimal"]
 integrators = ["cvode-bdf"]
 tol = [1e-6, 1e-9]
 

@@ -58,6 +58,16 @@ function(_cstab_write file content)
   file(WRITE ${file} "${content}")
 endfunction()
 
+# Under CSTAB_SANITIZE, compiles the pair unit FILE of problem class CLASS
+# without the sanitizers unless CLASS is in CSTAB_SANITIZE_CLASSES (or that
+# list is ALL).
+function(_cstab_sanitize_pair target class file)
+  if(NOT CSTAB_SANITIZE OR "ALL" IN_LIST CSTAB_SANITIZE_CLASSES OR class IN_LIST CSTAB_SANITIZE_CLASSES)
+    return()
+  endif()
+  set_source_files_properties(${file} TARGET_DIRECTORY ${target} PROPERTIES COMPILE_OPTIONS -fno-sanitize=all)
+endfunction()
+
 # Adds to METHODS_TARGET the method list and to PROBLEMS_TARGET one
 # translation unit per problem class x method pair, one adapter per class and
 # the problem list.
@@ -123,6 +133,12 @@ std::unique_ptr<Problem> adapt_with_every_method(P problem) {
 }  // namespace cstab
 ")
 
+  foreach(c ${CSTAB_SANITIZE_CLASSES})
+    if(NOT c STREQUAL "ALL" AND NOT c IN_LIST classes)
+      message(FATAL_ERROR "CSTAB_SANITIZE_CLASSES: unknown problem class ${c} (known: ${classes}; or ALL)")
+    endif()
+  endforeach()
+
   # Pairs: one unit per problem class x method; one adapter unit per class.
   foreach(c ${classes})
     _cstab_id(cid ${c})
@@ -134,6 +150,7 @@ std::unique_ptr<Problem> adapt_with_every_method(P problem) {
       set(fn cstab_pair_${cid}_${mid})
       _cstab_write(${dir}/pairs/${cid}__${mid}.cpp "${note}#include \"${mheader}\"\n#include \"${cheader}\"\n#include \"methods/pair.hpp\"\n\nnamespace cstab {\nPairOps ${fn}() { return pair_ops<${mclass}, ${c}>(); }\n}  // namespace cstab\n")
       target_sources(${problems_target} PRIVATE ${dir}/pairs/${cid}__${mid}.cpp)
+      _cstab_sanitize_pair(${problems_target} ${c} ${dir}/pairs/${cid}__${mid}.cpp)
       string(APPEND pair_decls "PairOps ${fn}();\n")
       string(APPEND pair_calls "${fn}(), ")
     endforeach()

@@ -1,7 +1,7 @@
 # Reads case summary.csv files (one row per repeat; the header of each file
 # names its columns) and prints, per problem x method (x formulation), the
 # case with the smallest median wall time whose reference error is <= TARGET:
-#   problem,method,formulation,integrator,setting,params,median_wall,repeats,ref_error,steps,rhs_evals,case_id
+#   problem,method,formulation,integrator,setting,params,median_wall,repeats,ref_error,steps,rhs_evals,case_id,newton_per_step
 # Fields are split on commas: no value of the columns used contains one.
 BEGIN { FS = ","; if (TARGET == "") TARGET = 1e-8 }
 FNR == 1 { delete col; for (i = 1; i <= NF; i++) col[$i] = i; next }
@@ -14,6 +14,10 @@ FNR == 1 { delete col; for (i = 1; i <= NF; i++) col[$i] = i; next }
   info[id] = $col["problem"] "," $col["method"] "," $col["formulation"] "," $col["integrator"] "," setting "," $col["params"]
   group[id] = $col["problem"] SUBSEP $col["method"] SUBSEP $col["formulation"]
   err[id] = $col["ref_error"]; steps[id] = $col["steps"]; evals[id] = $col["rhs_evals"]
+  # Newton (or augmented Lagrangian) iterations per step, for the
+  # self-stepping schemes; empty for the others.
+  nps[id] = ("newton_iters" in col && $col["newton_iters"] != "" && $col["steps"] + 0 > 0) ? \
+            sprintf("%.3g", $col["newton_iters"] / $col["steps"]) : ""
 }
 function median(id,    k, m, i, j, t, a) {
   m = n[id]
@@ -30,6 +34,6 @@ END {
   for (g in best) {
     id = best[g]
     # params hold ';' not ','; quote nothing
-    printf "%s,%.6g,%d,%s,%s,%s,%s\n", info[id], bestwall[g], n[id], err[id], steps[id], evals[id], id
+    printf "%s,%.6g,%d,%s,%s,%s,%s,%s\n", info[id], bestwall[g], n[id], err[id], steps[id], evals[id], id, nps[id]
   }
 }

@@ -11,7 +11,8 @@
 #                  speedup_vs_ida_ggl (IDA-GGL's median / this one's),
 #                  cost_vs_minimal (this one's / the minimal-coordinate ODE's)
 #   usage: scripts/speed.sh [OUT]        (default results/speed)
-#   env:   CSTAB (binary), JOBS (stage-1 parallel cases, default 2), REPEATS (default 9), TARGET (1e-8)
+#   env:   CSTAB (binary), JOBS (stage-1 parallel cases, default 2), REPEATS (default 9), TARGET (1e-8),
+#          SWEEP (stage 1's results folder, default OUT/sweep: two targets can share one sweep)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 OUT=${1:-results/speed}
@@ -19,13 +20,14 @@ CSTAB=${CSTAB:-build/release/cli/cstab}
 JOBS=${JOBS:-2}
 REPEATS=${REPEATS:-9}
 TARGET=${TARGET:-1e-8}
+SWEEP=${SWEEP:-$OUT/sweep}
 mkdir -p "$OUT"
 
-echo "speed: stage 1 (sweep) into $OUT/sweep" >&2
-"$CSTAB" matrix matrices/speed.toml --out "$OUT/sweep" --jobs "$JOBS" --no-report >"$OUT/sweep.log"
+echo "speed: stage 1 (sweep) into $SWEEP" >&2
+"$CSTAB" matrix matrices/speed.toml --out "$SWEEP" --jobs "$JOBS" --no-report >"$OUT/sweep.log"
 # Only the cases of this matrix (the folder may hold cases of earlier versions of it).
-ids=$(awk -F, 'NR == 1 { for (i = 1; i <= NF; i++) if ($i == "case_id") c = i; next } { print $c }' "$OUT/sweep/cases.csv")
-files=(); for id in $ids; do [[ -f "$OUT/sweep/cases/$id/summary.csv" ]] && files+=("$OUT/sweep/cases/$id/summary.csv"); done
+ids=$(awk -F, 'NR == 1 { for (i = 1; i <= NF; i++) if ($i == "case_id") c = i; next } { print $c }' "$SWEEP/cases.csv")
+files=(); for id in $ids; do [[ -f "$SWEEP/cases/$id/summary.csv" ]] && files+=("$SWEEP/cases/$id/summary.csv"); done
 awk -v TARGET="$TARGET" -f scripts/speed-best.awk "${files[@]}" | sort >"$OUT/stage1-best.csv"
 
 # Stage 2: one sweep per chosen case, all its parameters spelled out.
@@ -42,30 +44,34 @@ rm -rf "$OUT/retime"
 "$CSTAB" matrix "$OUT/retime.toml" --out "$OUT/retime" --jobs 1 --no-report >"$OUT/retime.log"
 awk -v TARGET="$TARGET" -f scripts/speed-best.awk "$OUT"/retime/cases/*/summary.csv | sort >"$OUT/stage2-best.csv"
 
-# Ratios within the stage-2 run.
+# Ratios within the stage-2 run: to IDA-GGL, to the minimal-coordinate ODE
+# and to the fastest method of the problem (the minimal ODE left out).
 awk -F, -v OFS=, '
   { row[NR] = $0; prob[NR] = $1; meth[NR] = $2; wall[NR] = $7
     if ($2 == "ida-ggl") ida[$1] = $7
-    if ($2 == "minimal") minimal[$1] = $7 }
+    if ($2 == "minimal") minimal[$1] = $7
+    else if (!($1 in fastest) || $7 < fastest[$1]) fastest[$1] = $7 }
   END {
-    print "problem,method,formulation,integrator,setting,params,median_wall_s,repeats,ref_error,steps,rhs_evals,case_id,speedup_vs_ida_ggl,cost_vs_minimal"
+    print "problem,method,formulation,integrator,setting,params,median_wall_s,repeats,ref_error,steps,rhs_evals,case_id,newton_per_step,speedup_vs_ida_ggl,cost_vs_minimal,cost_vs_fastest"
     for (i = 1; i <= NR; i++) {
       p = prob[i]
       s = (p in ida) ? sprintf("%.3g", ida[p] / wall[i]) : ""
       c = (p in minimal) ? sprintf("%.3g", wall[i] / minimal[p]) : ""
-      print row[i], s, c
+      f = meth[i] == "minimal" ? "" : sprintf("%.3g", wall[i] / fastest[p])
+      print row[i], s, c, f
     }
   }' "$OUT/stage2-best.csv" >"$OUT/speed.csv"
 
 # Markdown table: per problem, every method's cheapest setting, fastest first.
 {
-  echo "| problem | method | integrator, setting | median wall (ms) | ref error | IDA-GGL / this | this / minimal |"
-  echo "|---|---|---|---|---|---|---|"
+  echo "| problem | method | integrator, setting | median wall (ms) | ref error | Newton its / step | this / fastest | IDA-GGL / this | this / minimal |"
+  echo "|---|---|---|---|---|---|---|---|---|"
   tail -n +2 "$OUT/speed.csv" | sort -t, -k1,1 -k7,7g | awk -F, '{
     m = $2; if ($2 == "pesterev" && $3 != "mechanical") m = $2 " (" $3 ")"
-    lam = ""; if (match($6, /(^|;)(lambda|alpha|dt)=[^;]*/)) lam = ", " substr($6, RSTART + (substr($6, RSTART, 1) == ";"), RLENGTH - (substr($6, RSTART, 1) == ";"))
+    lam = ""; if (match($6, /(^|;)(lambda|alpha|dt|rho_inf)=[^;]*/)) lam = ", " substr($6, RSTART + (substr($6, RSTART, 1) == ";"), RLENGTH - (substr($6, RSTART, 1) == ";"))
     if ($2 == "baumgarte" && match($6, /beta=[^;]*/)) lam = lam ", " substr($6, RSTART, RLENGTH)
-    printf "| %s | %s | %s %s%s | %.3g | %.1e | %s | %s |\n", $1, m, $4, $5, lam, 1000 * $7, $9, $13 == "" ? "-" : $13 "x", $14 == "" ? "-" : $14 "x" }'
+    printf "| %s | %s | %s %s%s | %.3g | %.1e | %s | %s | %s | %s |\n", $1, m, $4, $5, lam, 1000 * $7, $9, $13 == "" ? "-" : $13,
+      $16 == "" ? "-" : $16 "x", $14 == "" ? "-" : $14 "x", $15 == "" ? "-" : $15 "x" }'
 } >"$OUT/speed.md"
 cat "$OUT/speed.md"
 echo "speed: wrote $OUT/speed.csv and $OUT/speed.md" >&2

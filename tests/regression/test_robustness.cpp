@@ -30,6 +30,7 @@ namespace cstab {
 namespace {
 
 namespace fs = std::filesystem;
+using cstab::testing::Outcome;
 using cstab::testing::quote;
 using cstab::testing::slurp;
 
@@ -184,22 +185,7 @@ TEST(FailingRuns, SingularReactionMatrixDuringTheRun) {
 // ---------------------------------------------------------------------------
 // The binary.
 
-struct Outcome {
-  int code = -1;
-  std::string out;
-};
-
-Outcome sh(const std::string& command) {
-  Outcome o;
-  std::FILE* p = ::popen((command + " 2>&1").c_str(), "r");
-  if (!p) return o;
-  char buf[4096];
-  size_t n;
-  while ((n = std::fread(buf, 1, sizeof buf, p)) > 0) o.out.append(buf, n);
-  const int status = ::pclose(p);
-  o.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return o;
-}
+Outcome sh(const std::string& command) { return cstab::testing::run_shell(command); }
 
 // A matrix with a diverging, a failing and a good case goes on to the end
 // and records each with its status and reason.
@@ -496,22 +482,7 @@ series = false
       std::this_thread::sleep_for(std::chrono::milliseconds(2));
       continue;
     }
-    for (const auto& e : fs::directory_iterator("/proc", ec)) {
-      const std::string name = e.path().filename().string();
-      if (name.find_first_not_of("0123456789") != std::string::npos) continue;
-      std::ifstream stat(e.path() / "stat");
-      std::string line;
-      std::getline(stat, line);
-      // "pid (comm) state ppid ...": the ppid after the closing parenthesis.
-      const size_t close = line.rfind(')');
-      if (close == std::string::npos) continue;
-      std::istringstream rest(line.substr(close + 1));
-      std::string state;
-      long ppid = 0;
-      rest >> state >> ppid;
-      if (ppid != pid || fs::read_symlink(e.path() / "exe", ec) != binary) continue;
-      killed = ::kill(pid_t(std::stol(name)), SIGTERM) == 0;
-    }
+    for (pid_t w : cstab::testing::children_running(pid, binary)) killed = ::kill(w, SIGTERM) == 0 || killed;
     if (!killed) std::this_thread::sleep_for(std::chrono::milliseconds(5));
   }
   EXPECT_TRUE(killed);

@@ -78,25 +78,7 @@ int wait_code(pid_t pid) {
 
 // The pids whose parent is `parent` and whose executable is the cstab binary.
 std::vector<pid_t> workers_of(pid_t parent) {
-  std::vector<pid_t> found;
-  const fs::path binary = fs::canonical(CSTAB_BINARY);
-  std::error_code ec;
-  for (const auto& e : fs::directory_iterator("/proc", ec)) {
-    const std::string name = e.path().filename().string();
-    if (name.find_first_not_of("0123456789") != std::string::npos) continue;
-    std::ifstream stat(e.path() / "stat");
-    std::string line;
-    std::getline(stat, line);
-    const size_t close = line.rfind(')');
-    if (close == std::string::npos) continue;
-    std::istringstream rest(line.substr(close + 1));
-    std::string state;
-    long ppid = 0;
-    rest >> state >> ppid;
-    if (ppid == parent && state != "Z" && fs::read_symlink(e.path() / "exe", ec) == binary)
-      found.push_back(pid_t(std::stol(name)));
-  }
-  return found;
+  return cstab::testing::children_running(parent, fs::canonical(CSTAB_BINARY));
 }
 
 // Every process whose executable is the binary and whose command line

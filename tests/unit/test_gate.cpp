@@ -24,29 +24,14 @@
 namespace fs = std::filesystem;
 using cstab::ThresholdsFile;
 using cstab::UsageError;
+using cstab::testing::cstab_cmd;
 using cstab::testing::exit_code;
+using cstab::testing::Outcome;
 using cstab::testing::quote;
 using cstab::testing::Scratch;
 using cstab::testing::slurp;
 
 namespace {
-
-struct Outcome {
-  int code = -1;
-  std::string out;  // stdout and stderr
-};
-
-Outcome cstab_cmd(const std::string& args) {
-  const std::string cmd = quote(CSTAB_BINARY) + " " + args + " 2>&1";
-  Outcome o;
-  std::FILE* p = ::popen(cmd.c_str(), "r");
-  if (!p) return o;
-  char buf[4096];
-  size_t n;
-  while ((n = std::fread(buf, 1, sizeof buf, p)) > 0) o.out.append(buf, n);
-  o.code = exit_code(::pclose(p));
-  return o;
-}
 
 void write(const fs::path& p, const std::string& text) {
   std::ofstream(p, std::ios::binary) << text;

@@ -342,6 +342,10 @@ TEST(GeneralizedAlphaCli, BadParametersExitTwoWithOneLineAndNoOutput) {
       {"ali3p", "own", "alpha=-1e9", "alpha"},
       {"ali3p", "own", "iterations=0", "iterations"},
       {"ali3p", "own", "tol=nan", "tol"},
+      {"penalty", "rk4", "alpha=0", "alpha"},
+      {"penalty", "rk4", "omega=-10", "omega"},
+      {"penalty", "rk4", "xi=nan", "xi"},
+      {"penalty", "own", "", "--integrator"},
       {"generalized-alpha", "rk4", "rho_inf=0.5", "--integrator"},  // wrong pairing
       {"baumgarte", "own", "", "--integrator"},
   };

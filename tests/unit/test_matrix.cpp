@@ -401,22 +401,8 @@ TEST(MatrixExpand, ShippedMatricesExpand) {
 // ---------------------------------------------------------------------------
 // Runs of the binary.
 
-struct Output {
-  int code;
-  std::string text;
-};
-
-Output sh(const std::string& command) {
-  Output out{-1, ""};
-  std::FILE* p = ::popen((command + " 2>&1").c_str(), "r");
-  if (!p) return out;
-  char buf[4096];
-  size_t n;
-  while ((n = std::fread(buf, 1, sizeof buf, p)) > 0) out.text.append(buf, n);
-  const int status = ::pclose(p);
-  out.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return out;
-}
+using cstab::testing::Outcome;
+Outcome sh(const std::string& command) { return cstab::testing::run_shell(command); }
 
 std::string slurp(const std::string& path) {
   std::ifstream in(path);
@@ -434,13 +420,13 @@ TEST(MatrixCli, SyntaxErrorExitsTwoWithFileLineColumnAndNoOutput) {
   for (const char* what : {" --list", " --out "}) {
     SCOPED_TRACE(what);
     const std::string out_dir = dir + "/out";
-    const Output o = sh(std::string(CSTAB_BINARY) + " matrix " + dir + "/bad.toml" + what +
+    const Outcome o = sh(std::string(CSTAB_BINARY) + " matrix " + dir + "/bad.toml" + what +
                         (std::string(what) == " --out " ? out_dir : ""));
-    EXPECT_EQ(o.code, 2) << o.text;
+    EXPECT_EQ(o.code, 2) << o.out;
     const std::string prefix = "cstab matrix: error: " + dir + "/bad.toml:4:1: ";
-    EXPECT_EQ(o.text.substr(0, prefix.size()), prefix) << o.text;
-    EXPECT_NE(o.text.find("array"), std::string::npos) << o.text;
-    EXPECT_EQ(std::count(o.text.begin(), o.text.end(), '\n'), 1) << o.text;
+    EXPECT_EQ(o.out.substr(0, prefix.size()), prefix) << o.out;
+    EXPECT_NE(o.out.find("array"), std::string::npos) << o.out;
+    EXPECT_EQ(std::count(o.out.begin(), o.out.end(), '\n'), 1) << o.out;
     EXPECT_FALSE(fs::exists(out_dir));
   }
   fs::remove_all(dir);
@@ -487,14 +473,14 @@ methods = ["pesterev", "minimal"]
     if (!::testing::Test::HasFailure()) fs::remove_all(dir_);
   }
   static std::string dir_;
-  static Output single_;
+  static Outcome single_;
 };
 std::string MatrixRun::dir_;
-Output MatrixRun::single_;
+Outcome MatrixRun::single_;
 
 TEST_F(MatrixRun, SingleRunWritesResultsPlotsAndReport) {
-  ASSERT_EQ(single_.code, 0) << single_.text;
-  EXPECT_NE(single_.text.find("10 cases: 10 run, 0 cached, in "), std::string::npos) << single_.text;
+  ASSERT_EQ(single_.code, 0) << single_.out;
+  EXPECT_NE(single_.out.find("10 cases: 10 run, 0 cached, in "), std::string::npos) << single_.out;
   for (const char* f : {"summary.csv", "cases.csv", "matrix.toml", "provenance.txt", "work_precision.csv",
                         "fastest.csv", "report.html", "plots/wheel_work_precision.png", "plots/wheel_overlay.png",
                         "plots/wheel_trajectory.png", "plots/replot.sh", "plots/data/wheel_overlay.dat.gz"})
@@ -521,13 +507,13 @@ TEST_F(MatrixRun, SingleRunWritesResultsPlotsAndReport) {
 }
 
 TEST_F(MatrixRun, UnchangedRerunRunsNothing) {
-  ASSERT_EQ(single_.code, 0) << single_.text;
+  ASSERT_EQ(single_.code, 0) << single_.out;
   const std::string before = slurp(dir_ + "/single/summary.csv");
-  const Output again = sh(std::string(CSTAB_BINARY) + " matrix " + dir_ + "/tiny.toml --out " + dir_ + "/single");
-  ASSERT_EQ(again.code, 0) << again.text;
-  EXPECT_NE(again.text.find("10 of 10 cases cached"), std::string::npos) << again.text;
-  EXPECT_NE(again.text.find("0 run, 10 cached"), std::string::npos) << again.text;
-  EXPECT_NE(again.text.find("0 plots drawn"), std::string::npos) << again.text;
+  const Outcome again = sh(std::string(CSTAB_BINARY) + " matrix " + dir_ + "/tiny.toml --out " + dir_ + "/single");
+  ASSERT_EQ(again.code, 0) << again.out;
+  EXPECT_NE(again.out.find("10 of 10 cases cached"), std::string::npos) << again.out;
+  EXPECT_NE(again.out.find("0 run, 10 cached"), std::string::npos) << again.out;
+  EXPECT_NE(again.out.find("0 plots drawn"), std::string::npos) << again.out;
   EXPECT_EQ(slurp(dir_ + "/single/summary.csv"), before);  // nothing rerun: even the timings are the same
   // No wall-time bound here (a timed test fails under the sanitizers and on a
   // loaded machine): "0 run", "0 plots drawn" and the unchanged summary say
@@ -535,25 +521,25 @@ TEST_F(MatrixRun, UnchangedRerunRunsNothing) {
 }
 
 TEST_F(MatrixRun, TwoShardsThroughGnuParallelMergeToTheSingleRun) {
-  ASSERT_EQ(single_.code, 0) << single_.text;
+  ASSERT_EQ(single_.code, 0) << single_.out;
   ASSERT_EQ(sh("command -v parallel").code, 0) << "GNU parallel is not installed (scripts/install-deps.sh)";
-  const Output shards = sh("cd " + dir_ + " && parallel --will-cite " + CSTAB_BINARY +
+  const Outcome shards = sh("cd " + dir_ + " && parallel --will-cite " + CSTAB_BINARY +
                            " matrix tiny.toml --shard {}/2 --out shard{} --jobs 1 ::: 1 2");
-  ASSERT_EQ(shards.code, 0) << shards.text;
+  ASSERT_EQ(shards.code, 0) << shards.out;
   const size_t n1 = read_csv(dir_ + "/shard1/cases.csv").rows.size();
   const size_t n2 = read_csv(dir_ + "/shard2/cases.csv").rows.size();
   EXPECT_EQ(n1 + n2, 10u);
   EXPECT_GE(n1, 4u);
   EXPECT_GE(n2, 4u);
-  const Output merge = sh(std::string(CSTAB_BINARY) + " merge " + dir_ + "/merged " + dir_ + "/shard1 " + dir_ +
+  const Outcome merge = sh(std::string(CSTAB_BINARY) + " merge " + dir_ + "/merged " + dir_ + "/shard1 " + dir_ +
                           "/shard2 --no-report");
-  ASSERT_EQ(merge.code, 0) << merge.text;
+  ASSERT_EQ(merge.code, 0) << merge.out;
   EXPECT_EQ(cstab::testing::summary_without_timing(dir_ + "/merged/summary.csv"),
             cstab::testing::summary_without_timing(dir_ + "/single/summary.csv"));
   EXPECT_EQ(slurp(dir_ + "/merged/cases.csv"), slurp(dir_ + "/single/cases.csv"));
   // A missing shard is reported, with exit code 3.
-  const Output partial = sh(std::string(CSTAB_BINARY) + " merge " + dir_ + "/partial " + dir_ + "/shard1 --no-report");
-  EXPECT_EQ(partial.code, 3) << partial.text;
+  const Outcome partial = sh(std::string(CSTAB_BINARY) + " merge " + dir_ + "/partial " + dir_ + "/shard1 --no-report");
+  EXPECT_EQ(partial.code, 3) << partial.out;
 }
 
 // The pictures' names in a folder's plots/ with the given extension.
@@ -612,11 +598,11 @@ TEST_F(MatrixRun, ReportPicturesOnDemand) {
 }
 
 TEST_F(MatrixRun, ReportOpensInHeadlessChromiumWithEveryImageLoaded) {
-  ASSERT_EQ(single_.code, 0) << single_.text;
-  const Output check = sh("bash " CSTAB_SOURCE_DIR "/scripts/check-report.sh " + dir_ + "/single " + dir_ + "/shot.png");
-  if (check.code == 77) GTEST_SKIP() << check.text;
-  ASSERT_EQ(check.code, 0) << check.text;
-  EXPECT_NE(check.text.find("images loaded"), std::string::npos) << check.text;
+  ASSERT_EQ(single_.code, 0) << single_.out;
+  const Outcome check = sh("bash " CSTAB_SOURCE_DIR "/scripts/check-report.sh " + dir_ + "/single " + dir_ + "/shot.png");
+  if (check.code == 77) GTEST_SKIP() << check.out;
+  ASSERT_EQ(check.code, 0) << check.out;
+  EXPECT_NE(check.out.find("images loaded"), std::string::npos) << check.out;
   EXPECT_TRUE(fs::exists(dir_ + "/shot.png"));
 }
 

@@ -128,6 +128,33 @@ TEST(RedundantConstraints, AugmentedLagrangianRunsAndConvergesAtSecondOrder) {
   EXPECT_NEAR(gap[0] / gap[1], 4.0, 0.6) << gap[0] << " " << gap[1];
 }
 
+// The penalty formulation runs on redundant rows too (M + p A^T A stays
+// positive definite), but holds the constraints only to O(1/p): a hundred
+// times the penalty, a hundred times smaller residual and gap to the
+// projected rk8pd solution (an independent formulation).
+TEST(RedundantConstraints, PenaltyRunsWithErrorsFallingAsOneOverThePenalty) {
+  RunConfig ref_cfg = config("projection", "rk8pd");
+  ref_cfg.step.rtol = ref_cfg.step.atol = 1e-12;
+  const RunResult ref = run_case(problem(), ref_cfg, "");
+  ASSERT_EQ(ref.status, "ok") << ref.reason;
+  double residual[2], gap[2];
+  for (int k = 0; k < 2; ++k) {
+    RunConfig cfg = config("penalty", "rk8pd");
+    cfg.step.rtol = cfg.step.atol = 1e-12;
+    cfg.params = {{"alpha", k == 0 ? "1e4" : "1e6"}};
+    const RunResult r = run_case(problem(), cfg, "");
+    ASSERT_EQ(r.status, "ok") << r.reason;
+    ASSERT_EQ(r.final_state.size(), 4u);
+    residual[k] = r.max_residual;
+    gap[k] = 0;
+    for (int i = 0; i < 4; ++i) gap[k] = std::max(gap[k], std::abs(r.final_state[i] - ref.final_state[i]));
+  }
+  EXPECT_LT(residual[0], 1e-4);
+  EXPECT_GT(residual[0], 1e-8) << "a penalty cannot hold the rows to the integrator's tolerance";
+  EXPECT_NEAR(std::log10(residual[0] / residual[1]), 2.0, 0.3) << residual[0] << " " << residual[1];
+  EXPECT_NEAR(std::log10(gap[0] / gap[1]), 2.0, 0.3) << gap[0] << " " << gap[1];
+}
+
 TEST(RedundantConstraints, FullRankMethodsRefuseWithAClearError) {
   for (const auto& [method, integrator] : std::vector<std::pair<std::string, std::string>>{
            {"baumgarte", "rk8pd"}, {"pesterev", "rk8pd"}, {"ida-index1", "ida"}, {"ida-ggl", "ida"},

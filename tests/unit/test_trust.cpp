@@ -34,30 +34,14 @@
 #include "tests/support/test_util.hpp"
 
 namespace fs = std::filesystem;
+using cstab::testing::contains;
+using cstab::testing::cstab_cmd;
+using cstab::testing::Outcome;
 using cstab::testing::quote;
 using cstab::testing::Scratch;
 using cstab::testing::slurp;
 
 namespace {
-
-struct Outcome {
-  int code = -1;
-  std::string out;  // stdout and stderr
-};
-
-Outcome cstab_cmd(const std::string& args) {
-  const std::string cmd = quote(CSTAB_BINARY) + " " + args + " 2>&1";
-  Outcome o;
-  std::FILE* p = ::popen(cmd.c_str(), "r");
-  char buf[4096];
-  size_t n;
-  while ((n = std::fread(buf, 1, sizeof buf, p)) > 0) o.out.append(buf, n);
-  const int status = ::pclose(p);
-  o.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return o;
-}
-
-bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
 
 // Every file below `dir` with its content, for "nothing changed" checks.
 std::string snapshot(const fs::path& dir) {
