@@ -557,43 +557,43 @@ std::set<std::string> pictures(const std::string& plots, const std::string& ext)
 // its drift picture, whose gnuplot fails.)
 TEST_F(MatrixRun, ReportPicturesOnDemand) {
   const std::string dir = dir_ + "/svg", plots = dir + "/plots";
-  Output o = sh(std::string(CSTAB_BINARY) + " matrix " + dir_ + "/tiny.toml --filter fixed --out " + dir);
-  ASSERT_EQ(o.code, 0) << o.text;
+  Outcome o = sh(std::string(CSTAB_BINARY) + " matrix " + dir_ + "/tiny.toml --filter fixed --out " + dir);
+  ASSERT_EQ(o.code, 0) << o.out;
   const std::set<std::string> png = pictures(plots, ".png");
   EXPECT_EQ(png, (std::set<std::string>{"wheel_overlay", "wheel_trajectory", "wheel_work_precision"}));
   EXPECT_TRUE(pictures(plots, ".svg").empty());
   o = sh(std::string(CSTAB_BINARY) + " report " + dir + " --svg");
-  ASSERT_EQ(o.code, 0) << o.text;
-  EXPECT_NE(o.text.find("(" + std::to_string(png.size()) + " plots drawn, 0 unchanged)"), std::string::npos) << o.text;
+  ASSERT_EQ(o.code, 0) << o.out;
+  EXPECT_NE(o.out.find("(" + std::to_string(png.size()) + " plots drawn, 0 unchanged)"), std::string::npos) << o.out;
   EXPECT_EQ(pictures(plots, ".svg"), png);
   EXPECT_NE(slurp(dir + "/report.html").find("<code>plots/wheel_overlay.svg</code>"), std::string::npos);
   o = sh(std::string(CSTAB_BINARY) + " report " + dir);
-  ASSERT_EQ(o.code, 0) << o.text;
-  EXPECT_NE(o.text.find("(0 plots drawn, " + std::to_string(png.size()) + " unchanged)"), std::string::npos) << o.text;
+  ASSERT_EQ(o.code, 0) << o.out;
+  EXPECT_NE(o.out.find("(0 plots drawn, " + std::to_string(png.size()) + " unchanged)"), std::string::npos) << o.out;
   EXPECT_EQ(pictures(plots, ".svg"), png);
   // replot.sh: the same PNGs, and the SVGs again after they were removed.
   const std::string first = slurp(plots + "/wheel_overlay.png");
   for (const auto& name : png) fs::remove(plots + "/" + name + ".svg");
   o = sh("sh " + plots + "/replot.sh");
-  ASSERT_EQ(o.code, 0) << o.text;
+  ASSERT_EQ(o.code, 0) << o.out;
   EXPECT_EQ(pictures(plots, ".svg"), png);
   EXPECT_EQ(slurp(plots + "/wheel_overlay.png"), first);
   // Without --svg, a redrawn picture loses its SVG (it would be stale).
   fs::remove(plots + "/data/wheel_overlay.stamp");
   o = sh(std::string(CSTAB_BINARY) + " report " + dir);
-  ASSERT_EQ(o.code, 0) << o.text;
+  ASSERT_EQ(o.code, 0) << o.out;
   EXPECT_FALSE(fs::exists(plots + "/wheel_overlay.svg"));
   EXPECT_TRUE(fs::exists(plots + "/wheel_trajectory.svg"));
   // --svg where nothing is drawn is bad input, and changes nothing.
   for (const std::string& bad : {" report " + dir + " --svg --no-plots", " merge " + dir_ + "/svg2 " + dir +
                                                                           " --svg --no-report"}) {
     o = sh(std::string(CSTAB_BINARY) + bad);
-    EXPECT_EQ(o.code, 2) << bad << "\n" << o.text;
-    EXPECT_NE(o.text.find("--svg: draws the pictures; not with --no-"), std::string::npos) << o.text;
+    EXPECT_EQ(o.code, 2) << bad << "\n" << o.out;
+    EXPECT_NE(o.out.find("--svg: draws the pictures; not with --no-"), std::string::npos) << o.out;
   }
   EXPECT_FALSE(fs::exists(dir_ + "/svg2"));
   o = sh(std::string(CSTAB_BINARY) + " matrix " + dir_ + "/tiny.toml --out " + dir_ + "/svg3 --shard 1/2 --svg");
-  EXPECT_EQ(o.code, 2) << o.text;
+  EXPECT_EQ(o.code, 2) << o.out;
   EXPECT_FALSE(fs::exists(dir_ + "/svg3"));
 }
 
