@@ -184,10 +184,22 @@ int jobs_flag(const Args& args) {
   return int(jobs);
 }
 
-ReportResult finish(const std::string& dir, int jobs, bool plots) {
+// --svg: the pictures as SVG too (by default PNG only; plots/replot.sh draws both).
+void declare_svg(Args& args) {
+  args.flag("--svg", "also draw every picture as SVG (plots/NAME.svg); by default only the PNGs are drawn");
+}
+
+// --svg, refused (exit 2) beside `other`, a flag under which no picture is drawn.
+bool svg_flag(const Args& args, const std::string& other) {
+  if (args.has("--svg") && args.has(other)) throw UsageError("--svg: draws the pictures; not with " + other);
+  return args.has("--svg");
+}
+
+ReportResult finish(const std::string& dir, int jobs, bool plots, bool svg) {
   ReportOptions ro;
   ro.jobs = jobs;
   ro.plots = plots;
+  ro.svg = svg;
   ReportResult r = build_report(dir, ro, std::cerr);
   std::cout << "report: " << r.html << " (" << r.plots_drawn << " plots drawn, " << r.plots_reused
             << " unchanged)\n";
@@ -200,13 +212,17 @@ std::string one_decimal(double v) {
   return text;
 }
 
-// After the report: the series no picture reads go (each case stays cached),
+// After the report: the series no picture reads go, the others are cut to
+// the columns the pictures read at plot precision (each case stays cached),
 // unless the case keeps them (keep_series, --keep-series).
-void drop_series(const std::string& out, const std::vector<MatrixCase>& cases, const ReportResult& report) {
-  const DroppedSeries d = drop_unused_series(out, cases, report.series_used);
-  if (d.cases)
-    std::cout << "matrix: kept the series the pictures read; dropped " << d.cases << " others ("
-              << one_decimal(double(d.bytes) / 1e6) << " MB; --keep-series or keep_series = true keeps them)\n";
+void shrink_series_after(const std::string& out, const std::vector<MatrixCase>& cases, const ReportResult& report) {
+  const SeriesShrunk d = shrink_series(out, cases, report.series_used);
+  if (d.dropped)
+    std::cout << "matrix: kept the series the pictures read; dropped " << d.dropped << " others ("
+              << one_decimal(double(d.dropped_bytes) / 1e6) << " MB; --keep-series or keep_series = true keeps them)\n";
+  if (d.reduced)
+    std::cout << "matrix: cut the " << d.reduced << " series the pictures read to their columns and 7 digits ("
+              << one_decimal(double(d.reduced_bytes_saved) / 1e6) << " MB less; --keep-series keeps them whole)\n";
 }
 
 // Outcomes over the whole folder, cached cases included: "3 ok, 1 diverged".
@@ -266,9 +282,10 @@ void declare_matrix(Args& a) {
   a.value("--shard", "K/N", "run only shard K of N (join the shard folders with `cstab merge`)")
       .value("--filter", "S", "run only the cases whose label contains S, or whose id or sweep name is S (see --list)")
       .flag("--force", "rerun cases even if their results are in DIR")
-      .flag("--no-report", "do not build the report after the run (every series is then kept)")
-      .flag("--keep-series", "keep every case's series (as matrix key keep_series = true); by default only "
-                             "the series the report's pictures read are kept")
+      .flag("--no-report", "do not build the report after the run (every series is then kept)");
+  declare_svg(a);
+  a.flag("--keep-series", "keep every case's series whole (as matrix key keep_series = true); by default only "
+                          "the series the report's pictures read are kept, cut to their columns and 7 digits")
       .flag("--list", "print the cases (index, id, sweep, label) and exit; no --out needed")
       .flag("--print-default", "print the embedded default matrix and exit");
 }
@@ -290,6 +307,8 @@ int cmd_matrix(const Args& args) {
     throw UsageError("--filter '" + filter + "': matches none of the " + std::to_string(expansion.cases.size()) +
                      " cases (see --list)");
   auto cases = select_cases(filtered, "", shard_k, shard_n);
+  const bool svg = svg_flag(args, "--no-report");
+  if (svg && shard_n > 1) throw UsageError("--svg: a shard builds no report; give it to `cstab merge`");
   if (args.has("--keep-series"))
     for (auto& c : cases) c.keep_series = true;
 
@@ -355,7 +374,7 @@ int cmd_matrix(const Args& args) {
     std::cout << "matrix: shard " << shard_k << "/" << shard_n << " done; join the shards with `cstab merge OUT "
               << "SHARD_DIR...`\n";
   else if (!args.has("--no-report"))
-    drop_series(out, cases, finish(out, jobs, true));
+    shrink_series_after(out, cases, finish(out, jobs, true, svg));
   return 0;
 }
 
@@ -364,14 +383,16 @@ void declare_merge(Args& a) {
       .positional("SHARD_DIR", "results folders of `cstab matrix --shard K/N` (at least one)", true, true);
   declare_jobs(a, "plots");
   a.flag("--no-report", "do not build the report of OUT");
+  declare_svg(a);
 }
 
 int cmd_merge(const Args& args) {
   const std::string out = args.require("OUT");
   const std::vector<std::string> shards = args.all("SHARD_DIR");
   const int jobs = jobs_flag(args);  // before anything is written
+  const bool svg = svg_flag(args, "--no-report");
   const size_t missing = merge_results(out, shards, std::cout);
-  if (!args.has("--no-report")) finish(out, jobs, true);
+  if (!args.has("--no-report")) finish(out, jobs, true, svg);
   if (missing) {
     std::cerr << "cstab merge: " << missing << " cases of the matrix are missing from the shards (exit code 3)\n";
     return 3;
@@ -383,11 +404,13 @@ void declare_report(Args& a) {
   a.positional("DIR", "a matrix results folder (cstab matrix --out)", true);
   declare_jobs(a, "plots");
   a.flag("--no-plots", "tables and HTML only, no gnuplot");
+  declare_svg(a);
 }
 
 int cmd_report(const Args& args) {
   const std::string dir = args.require("DIR");
   const int jobs = jobs_flag(args);
+  const bool svg = svg_flag(args, "--no-plots");
   // A results folder has its cases; anything else is refused untouched.
   if (!std::filesystem::is_directory(dir)) throw UsageError(dir + ": no such results folder");
   if (!std::filesystem::is_directory(dir + "/cases"))
@@ -395,7 +418,7 @@ int cmd_report(const Args& args) {
   const std::vector<CaseEntry> entries = read_results_manifest(dir);
   const FolderLock lock(dir, "cstab report");
   write_matrix_summary(dir, entries);
-  finish(dir, jobs, !args.has("--no-plots"));
+  finish(dir, jobs, !args.has("--no-plots"), svg);
   return 0;
 }
 

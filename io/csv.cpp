@@ -146,4 +146,42 @@ void write_file_atomic(const std::string& path, const std::string& content) {
   f.commit();
 }
 
+namespace {
+
+// The cells of one line, split at every comma.
+std::vector<std::string> split_commas(const std::string& line) {
+  std::vector<std::string> cells(1);
+  for (char c : line) {
+    if (c == ',')
+      cells.emplace_back();
+    else
+      cells.back() += c;
+  }
+  return cells;
+}
+
+}  // namespace
+
+std::string csv_select_columns(const std::string& csv, const std::set<std::string>& names) {
+  if (names.empty()) return csv;
+  std::vector<size_t> keep;
+  std::string out;
+  size_t begin = 0;
+  while (begin < csv.size()) {
+    size_t end = csv.find('\n', begin);
+    if (end == std::string::npos) end = csv.size();
+    const std::vector<std::string> cells = split_commas(csv.substr(begin, end - begin));
+    if (begin == 0)
+      for (size_t i = 0; i < cells.size(); ++i)
+        if (i == 0 || names.count(cells[i])) keep.push_back(i);
+    for (size_t k = 0; k < keep.size() && keep[k] < cells.size(); ++k) {
+      if (k) out += ',';
+      out += cells[keep[k]];
+    }
+    if (end < csv.size()) out += '\n';
+    begin = end + 1;
+  }
+  return out;
+}
+
 }  // namespace cstab

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdio>
+#include <set>
 #include <stdexcept>
 #include <string>
 #include <utility>
@@ -61,5 +62,10 @@ void write_key_value_csv(const std::string& path,
 
 // Write `content` to `path` atomically.
 void write_file_atomic(const std::string& path, const std::string& content);
+
+// A CSV text without quoted cells (a series.csv) with only its first column
+// and the columns whose header names are in `names`, in their order; every
+// column if `names` is empty. A row's missing cells stay missing.
+std::string csv_select_columns(const std::string& csv, const std::set<std::string>& names);
 
 }  // namespace cstab

@@ -24,6 +24,22 @@ std::string plot_cell(double v) {
 
 std::string log_plot_cell(double v) { return v > 0 ? plot_cell(v) : "?"; }
 
+std::string csv_at_plot_precision(const std::string& csv) {
+  std::string out;
+  out.reserve(csv.size() / 2);
+  size_t at = csv.find('\n');
+  out.append(csv, 0, at == std::string::npos ? csv.size() : at + 1);
+  while (at != std::string::npos && at + 1 < csv.size()) {
+    const size_t begin = at + 1;
+    at = csv.find_first_of(",\n", begin);
+    const std::string cell = csv.substr(begin, (at == std::string::npos ? csv.size() : at) - begin);
+    double v = 0;
+    out += try_parse_number(cell, v) && std::isfinite(v) ? plot_cell(v) : cell;
+    if (at != std::string::npos) out += csv[at];
+  }
+  return out;
+}
+
 bool try_parse_number(const std::string& text, double& value) {
   size_t begin = 0, end = text.size();
   while (begin < end && (text[begin] == ' ' || text[begin] == '\t')) ++begin;

@@ -20,6 +20,13 @@ std::string plot_cell(double v);
 // The same for a log-scale axis: "?" unless finite and > 0.
 std::string log_plot_cell(double v);
 
+// A CSV text (a series.csv) with every finite number of its rows after the
+// header at plot precision (plot_cell: 7 significant digits); other cells
+// (empty, text, "nan", "inf") and the header unchanged. plot_cell of a cell
+// read back is the plot_cell of the exact number: a picture drawn from the
+// result is the one drawn from the exact series.
+std::string csv_at_plot_precision(const std::string& csv);
+
 // The number a whole cell holds ("1e-3", "0.001", "inf", "nan"); NaN if the
 // cell is empty or is not entirely a number (leading/trailing blanks aside).
 double parse_number(const std::string& text);

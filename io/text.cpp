@@ -1,5 +1,7 @@
 #include "io/text.hpp"
 
+#include <cctype>
+
 namespace cstab {
 
 std::string html_escape(const std::string& s) {
@@ -13,6 +15,21 @@ std::string html_escape(const std::string& s) {
       case '"': out += "&quot;"; break;
       default: out += c;
     }
+  }
+  return out;
+}
+
+std::string url_path_escape(const std::string& s) {
+  static const char* hex = "0123456789ABCDEF";
+  std::string out;
+  for (unsigned char c : s) {
+    if (std::isalnum(c) || c == '-' || c == '.' || c == '_' || c == '~') {
+      out += char(c);
+      continue;
+    }
+    out += '%';
+    out += hex[c >> 4];
+    out += hex[c & 15];
   }
   return out;
 }

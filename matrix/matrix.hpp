@@ -29,6 +29,7 @@
 
 #include <functional>
 #include <iosfwd>
+#include <map>
 #include <set>
 #include <string>
 #include <utility>
@@ -199,16 +200,23 @@ struct MatrixRunStats {
 MatrixRunStats run_matrix(const std::vector<MatrixCase>& cases, const MatrixRunOptions& options,
                           std::ostream& log, bool log_is_tty);
 
-// Drops the series of the finished cases in `cases` that neither keep them
-// (keep_series) nor are in `used` (the cases the report's pictures read).
-// Each stays cached: its key.txt no longer lists the series and says
-// `dropped series.csv.gz`. Returns how many were dropped and their bytes.
-struct DroppedSeries {
-  size_t cases = 0;
-  unsigned long long bytes = 0;
+// The series columns the report's pictures read, per case id; the first
+// column (t) is always kept, and an empty set keeps every column.
+using SeriesUse = std::map<std::string, std::set<std::string>>;
+
+// After the report, the series of the finished cases in `cases` that do
+// not keep them (keep_series): one no picture reads (not in `used`) is
+// dropped (key.txt no longer lists it and says `dropped series.csv.gz`);
+// one a picture reads is cut to the columns it reads, every number at plot
+// precision (csv_select_columns, csv_at_plot_precision; key.txt records the
+// new file and says `for-pictures series.csv.gz`), from which the report
+// draws the same pictures. Either way the case stays cached unless
+// keep_series later asks for its whole series.
+struct SeriesShrunk {
+  size_t dropped = 0, reduced = 0;
+  unsigned long long dropped_bytes = 0, reduced_bytes_saved = 0;
 };
-DroppedSeries drop_unused_series(const std::string& out_dir, const std::vector<MatrixCase>& cases,
-                                 const std::set<std::string>& used);
+SeriesShrunk shrink_series(const std::string& out_dir, const std::vector<MatrixCase>& cases, const SeriesUse& used);
 // "SIGINT", "SIGTERM", "SIGHUP" (for messages about `interrupted_by`).
 std::string stop_signal_name(int sig);
 

@@ -116,8 +116,9 @@ void write_result(const std::string& dir, const std::vector<Row>& rows, const st
 
 // Why the cached result in `dir` cannot be reused for `key` ("" if it can):
 // key.txt must hold this configuration and binary, then list every result
-// file with the size and hash it has now. A series dropped by an earlier run
-// (`dropped NAME`, drop_unused_series) is fine unless `need_series`.
+// file with the size and hash it has now. A series dropped or cut by an
+// earlier run (`dropped NAME`, `for-pictures NAME`: shrink_series) is fine
+// unless `need_series`.
 std::string cache_problem(const std::string& dir, const std::string& key, bool need_series) {
   std::string text;
   try {
@@ -133,8 +134,11 @@ std::string cache_problem(const std::string& dir, const std::string& key, bool n
     std::istringstream words(line);
     std::string tag, name, hash;
     unsigned long long size = 0;
-    if (line.rfind("dropped ", 0) == 0) {
-      if (need_series) return "its series was dropped by an earlier run (keep_series asks for it)";
+    if (line.rfind("dropped ", 0) == 0 || line.rfind("for-pictures ", 0) == 0) {
+      if (need_series)
+        return line[0] == 'd' ? "its series was dropped by an earlier run (keep_series asks for it)"
+                              : "its series was cut to the pictures' columns and 7 digits by an earlier run "
+                                "(keep_series asks for the whole one)";
       continue;
     }
     if (!(words >> tag >> name >> size >> hash) || tag != "file") return "key.txt: malformed line '" + line + "'";
@@ -866,38 +870,83 @@ size_t merge_results(const std::string& out_dir, const std::vector<std::string>&
   return uncovered + missing_results;
 }
 
-// Rewrites key.txt without the series' line (and with `dropped NAME`), then
-// removes the file: a crash between the two leaves a file key.txt does not
-// record, which cache_problem refuses, so the case runs again.
-DroppedSeries drop_unused_series(const std::string& out_dir, const std::vector<MatrixCase>& cases,
-                                 const std::set<std::string>& used) {
-  DroppedSeries dropped;
+namespace {
+
+// key.txt of `dir` with its `file NAME ...` line replaced by `lines`; ""
+// if key.txt is unreadable (unfinished: the next run redoes the case) or
+// does not record NAME (left for the cache check to refuse).
+std::string key_with(const std::string& dir, const std::string& name, const std::string& lines) {
+  std::string key;
+  try {
+    key = read_text_file(dir + "/key.txt");
+  } catch (const std::exception&) {
+    return "";
+  }
+  const size_t at = key.find("\nfile " + name + " ");
+  if (at == std::string::npos) return "";
+  const size_t end = key.find('\n', at + 1);
+  key.erase(at + 1, end == std::string::npos ? std::string::npos : end - at);
+  return key + lines;
+}
+
+// Drops a series: key.txt first (without the file's line, with `dropped
+// NAME`), then the file; a crash between the two leaves a file key.txt does
+// not record, which cache_problem refuses, so the case runs again.
+bool drop_series_file(const std::string& dir, const std::string& name) {
+  const std::string key = key_with(dir, name, "dropped " + name + "\n");
+  if (key.empty()) return false;
+  write_file_atomic(dir + "/key.txt", key);
+  std::error_code ec;
+  fs::remove(dir + "/" + name, ec);
+  return true;
+}
+
+// Cuts series.csv.gz to the `columns` the pictures read, at plot precision:
+// the file first, then key.txt with its new size and hash and
+// `for-pictures NAME`; a crash between the two leaves a file whose hash
+// key.txt does not match, so the case runs again. Returns the bytes saved;
+// 0 if it was cut before.
+unsigned long long cut_series_file(const std::string& dir, const std::set<std::string>& columns) {
+  const std::string name = "series.csv.gz", path = dir + "/" + name;
+  std::string whole;
+  try {
+    if (read_text_file(dir + "/key.txt").find("\nfor-pictures " + name + "\n") != std::string::npos) return 0;
+    whole = read_text_file(path);
+  } catch (const std::exception&) {
+    return 0;  // unfinished or missing: the cache check deals with it
+  }
+  const std::string csv = gzip_decompress(whole, kMaxInputFileBytes);
+  const std::string cut = gzip_compress(csv_at_plot_precision(csv_select_columns(csv, columns)));
+  const std::string line = "file " + name + " " + std::to_string(cut.size()) + " " + hash_hex(cut) + "\n";
+  const std::string key = key_with(dir, name, line + "for-pictures " + name + "\n");
+  if (key.empty() || cut.size() >= whole.size()) return 0;
+  write_file_atomic(path, cut);
+  write_file_atomic(dir + "/key.txt", key);
+  return whole.size() - cut.size();
+}
+
+}  // namespace
+
+SeriesShrunk shrink_series(const std::string& out_dir, const std::vector<MatrixCase>& cases, const SeriesUse& used) {
+  SeriesShrunk done;
   for (const auto& c : cases) {
-    if (c.keep_series || used.count(c.entry.id)) continue;
+    if (c.keep_series) continue;
     const std::string dir = case_folder(out_dir, c.entry.id);
+    if (const auto it = used.find(c.entry.id); it != used.end()) {
+      const unsigned long long saved = cut_series_file(dir, it->second);
+      done.reduced += saved > 0;
+      done.reduced_bytes_saved += saved;
+      continue;
+    }
     for (const char* name : {"series.csv.gz", "series.csv"}) {
-      const std::string path = dir + "/" + name;
       std::error_code ec;
-      const auto bytes = fs::file_size(path, ec);
-      if (ec) continue;
-      std::string key;
-      try {
-        key = read_text_file(dir + "/key.txt");
-      } catch (const std::exception&) {
-        continue;  // unfinished: the next run redoes it anyway
-      }
-      const std::string line = std::string("file ") + name + " ";
-      const size_t at = key.find("\n" + line);
-      if (at == std::string::npos) continue;  // not recorded: left for the cache check to refuse
-      const size_t end = key.find('\n', at + 1);
-      key.erase(at + 1, end == std::string::npos ? std::string::npos : end - at);
-      write_file_atomic(dir + "/key.txt", key + "dropped " + name + "\n");
-      fs::remove(path, ec);
-      ++dropped.cases;
-      dropped.bytes += bytes;
+      const auto bytes = fs::file_size(dir + "/" + name, ec);
+      if (ec || !drop_series_file(dir, name)) continue;
+      ++done.dropped;
+      done.dropped_bytes += bytes;
     }
   }
-  return dropped;
+  return done;
 }
 
 }  // namespace cstab

@@ -2,7 +2,7 @@
 # (one representative run per method, the same integrator where the matrix
 # allows), log scale.
 #
-#   gnuplot -e "data='DIR/plots/data/wheel_overlay.dat'; out='DIR/plots/wheel_overlay'; \
+#   gnuplot -e "data='DIR/plots/data/wheel_overlay.dat.gz'; out='DIR/plots/wheel_overlay'; \
 #               problem='wheel'; drift_label='|E(t) - E(0)|'; lcs='1 2 3'" plots/overlay.gp
 #
 # data (written by `cstab report`): one block per run, blocks separated by
@@ -10,7 +10,8 @@
 # run's label. Columns: 1 t [time units]  2 max_i |residual_i(t)|
 # 3 |drift of energy or first integral|. "?" marks an exact zero.
 # lcs: per block, the linetype (colour). has_drift = 0 omits the drift panel.
-# Writes out.png and out.svg.
+# Writes out.png and out.svg; formats = "png"
+# (what `cstab report` passes unless --svg) writes out.png alone.
 if (!exists("data") || !exists("out")) {
   print "usage: gnuplot -e \"data='ov.dat'; out='basename'\" overlay.gp"
   exit status 2
@@ -25,7 +26,8 @@ n = STATS_blocks
 if (!exists("lcs")) { lcs = ""; do for [i=1:n] { lcs = lcs." ".i } }
 lc(i) = int(word(lcs, i + 1))
 
-do for [fmt in "png svg"] {
+if (!exists("formats")) formats = "png svg"
+do for [fmt in formats] {
   if (fmt eq "png") { set terminal pngcairo enhanced size 1600,1000 font "DejaVu Sans,11" } \
   else { set terminal svg enhanced size 1600,1000 font "DejaVu Sans,11" dynamic background "#ffffff" }
   set output out.".".fmt

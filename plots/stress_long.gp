@@ -1,13 +1,14 @@
 # Long horizons: running max |E(t) - E(0)| against t, log-log, one curve per
 # method, with t^(1/2) and t^1 guides ending at the first curve's final value.
 #
-#   gnuplot -e "data='DIR/plots/data/stress_long-ball.dat'; out='DIR/plots/stress_long-ball'; \
+#   gnuplot -e "data='DIR/plots/data/stress_long-ball.dat.gz'; out='DIR/plots/stress_long-ball'; \
 #               title='long-ball'; lcs='1 2 3'" plots/stress_long.gp
 #
 # data (written by `cstab report`): one block per run, blocks separated by
 # two blank lines, each starting with a header line whose first field is the
 # label. Columns: 1 t  2 running max |E - E(0)| ("?": exactly zero).
-# Writes out.png and out.svg.
+# Writes out.png and out.svg; formats = "png"
+# (what `cstab report` passes unless --svg) writes out.png alone.
 if (!exists("data") || !exists("out")) {
   print "usage: gnuplot -e \"data='l.dat'; out='basename'\" stress_long.gp"
   exit status 2
@@ -23,7 +24,8 @@ tmax = STATS_max
 stats data index 0 using 2 nooutput
 yend = STATS_max
 
-do for [fmt in "png svg"] {
+if (!exists("formats")) formats = "png svg"
+do for [fmt in formats] {
   if (fmt eq "png") { set terminal pngcairo enhanced size 1300,800 font "DejaVu Sans,11" } \
   else { set terminal svg enhanced size 1300,800 font "DejaVu Sans,11" dynamic background "#ffffff" }
   set output out.".".fmt

@@ -1,14 +1,15 @@
 # Inconsistent starts: peak residual and recovery time against the
 # perturbation delta, log-log, one curve per method.
 #
-#   gnuplot -e "data='DIR/plots/data/stress_perturb_wheel.dat'; out='DIR/plots/stress_perturb_wheel'; \
+#   gnuplot -e "data='DIR/plots/data/stress_perturb_wheel.dat.gz'; out='DIR/plots/stress_perturb_wheel'; \
 #               problem='wheel'; lcs='1 2 3'" plots/stress_perturb.gp
 #
 # data (written by `cstab report`): one block per method, blocks separated
 # by two blank lines, each starting with a header line whose first field is
 # the label. Columns: 1 delta  2 initial residual  3 peak residual
 # 4 recovery time to 1e-10 ("?": never recovered, or the run diverged).
-# Writes out.png and out.svg.
+# Writes out.png and out.svg; formats = "png"
+# (what `cstab report` passes unless --svg) writes out.png alone.
 if (!exists("data") || !exists("out")) {
   print "usage: gnuplot -e \"data='p.dat'; out='basename'\" stress_perturb.gp"
   exit status 2
@@ -20,7 +21,8 @@ n = STATS_blocks
 if (!exists("lcs")) { lcs = ""; do for [i=1:n] { lcs = lcs." ".i } }
 lc(i) = int(word(lcs, i + 1))
 
-do for [fmt in "png svg"] {
+if (!exists("formats")) formats = "png svg"
+do for [fmt in formats] {
   if (fmt eq "png") { set terminal pngcairo enhanced size 1600,700 font "DejaVu Sans,11" } \
   else { set terminal svg enhanced size 1600,700 font "DejaVu Sans,11" dynamic background "#ffffff" }
   set output out.".".fmt

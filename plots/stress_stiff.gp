@@ -1,13 +1,14 @@
 # Stiffness: wall time and error against the feedback gain, log-log, one
 # curve per method[formulation]/integrator setting.
 #
-#   gnuplot -e "data='DIR/plots/data/stress_stiff.dat'; out='DIR/plots/stress_stiff'; lcs='1 2'" plots/stress_stiff.gp
+#   gnuplot -e "data='DIR/plots/data/stress_stiff.dat.gz'; out='DIR/plots/stress_stiff'; lcs='1 2'" plots/stress_stiff.gp
 #
 # data (written by `cstab report`): one block per curve, blocks separated by
 # two blank lines, each starting with a header line whose first field is the
 # label. Columns: 1 gain (lambda)  2 wall seconds  3 error at the reference
 # time  4 largest residual (plotted instead of 3 when has_ref = 0) ("?": diverged, failed or timed out).
-# Writes out.png and out.svg.
+# Writes out.png and out.svg; formats = "png"
+# (what `cstab report` passes unless --svg) writes out.png alone.
 if (!exists("data") || !exists("out")) {
   print "usage: gnuplot -e \"data='s.dat'; out='basename'\" stress_stiff.gp"
   exit status 2
@@ -19,7 +20,8 @@ n = STATS_blocks
 if (!exists("lcs")) { lcs = ""; do for [i=1:n] { lcs = lcs." ".i } }
 lc(i) = int(word(lcs, i + 1))
 
-do for [fmt in "png svg"] {
+if (!exists("formats")) formats = "png svg"
+do for [fmt in formats] {
   if (fmt eq "png") { set terminal pngcairo enhanced size 1600,750 font "DejaVu Sans,11" } \
   else { set terminal svg enhanced size 1600,750 font "DejaVu Sans,11" dynamic background "#ffffff" }
   set output out.".".fmt

@@ -1,5 +1,7 @@
 # Shared style for the cstab plots (loaded by the other scripts): a
-# colour-blind-safe palette and the PNG/SVG terminal settings.
+# colour-blind-safe palette and the PNG/SVG terminal settings; a `data`
+# file whose name ends in .gz (`cstab report` writes plots/data/NAME.dat.gz)
+# is read through gzip -dc.
 set linetype 1 lc rgb "#0072B2" lw 2 pt 7 ps 1.1
 set linetype 2 lc rgb "#D55E00" lw 2 pt 5 ps 1.1
 set linetype 3 lc rgb "#009E73" lw 2 pt 9 ps 1.3
@@ -16,3 +18,14 @@ set linetype cycle 12
 set datafile missing "?"
 set grid xtics ytics mxtics mytics lc rgb "#dddddd" lw 1
 set border lw 1.2
+# data = 'a.dat.gz' -> "< gzip -dc 'a.dat.gz' 2>/dev/null", a quote in the
+# name as '\''; gzip's complaint when gnuplot stops reading is not an error.
+if (exists("data") && strlen(data) > 3 && data[strlen(data) - 2:] eq ".gz") {
+  gz_rest = data; gz_quoted = ""
+  while (strstrt(gz_rest, "'") > 0) {
+    gz_at = strstrt(gz_rest, "'")
+    gz_quoted = gz_quoted . gz_rest[1:gz_at - 1] . "'\\''"
+    gz_rest = gz_rest[gz_at + 1:]
+  }
+  data = "< gzip -dc '" . gz_quoted . gz_rest . "' 2>/dev/null"
+}

@@ -1,13 +1,14 @@
 # Trajectories of one problem: each selected coordinate against time, one
 # panel per coordinate, one representative run per method overlaid.
 #
-#   gnuplot -e "data='DIR/plots/data/wheel_trajectory.dat'; out='DIR/plots/wheel_trajectory'; \
+#   gnuplot -e "data='DIR/plots/data/wheel_trajectory.dat.gz'; out='DIR/plots/wheel_trajectory'; \
 #               problem='wheel'; names='x z theta phi alpha'; lcs='1 2 3'" plots/trajectory.gp
 #
 # data (written by `cstab report`): one block per run, blocks separated by
 # two blank lines, each starting with a header line whose first field is the
 # run's label. Columns: 1 t, then one column per name in `names`.
-# lcs: per block, the linetype (colour). Writes out.png and out.svg.
+# lcs: per block, the linetype (colour). Writes out.png and out.svg; formats = "png"
+# (what `cstab report` passes unless --svg) writes out.png alone.
 if (!exists("data") || !exists("out") || !exists("names")) {
   print "usage: gnuplot -e \"data='tr.dat'; out='basename'; names='x y'\" trajectory.gp"
   exit status 2
@@ -25,7 +26,8 @@ rows = int((k + cols - 1) / cols)
 # The legend takes a free panel slot, or a row of its own.
 slots = (rows * cols > k ? rows : rows + 1)
 
-do for [fmt in "png svg"] {
+if (!exists("formats")) formats = "png svg"
+do for [fmt in formats] {
   if (fmt eq "png") { set terminal pngcairo enhanced size 1600,(120 + 330 * slots) font "DejaVu Sans,11" } \
   else { set terminal svg enhanced size 1600,(120 + 330 * slots) font "DejaVu Sans,11" dynamic background "#ffffff" }
   set output out.".".fmt

@@ -4,7 +4,7 @@
 # correct digits, as the largest constraint residual, as the largest energy
 # (or first-integral) drift. Colour = method, point and dash = integrator.
 #
-#   gnuplot -e "data='DIR/plots/data/wheel_work_precision.dat'; out='DIR/plots/wheel_work_precision'; \
+#   gnuplot -e "data='DIR/plots/data/wheel_work_precision.dat.gz'; out='DIR/plots/wheel_work_precision'; \
 #               problem='wheel'; drift_label='max |E(t) - E(0)|'; ref_label='t = 5'; \
 #               lcs='1 2 1'; pts='7 7 5'; dts='1 1 2'" plots/work_precision.gp
 #
@@ -18,7 +18,8 @@
 # lcs, pts, dts: per block, the linetype (colour), point type and dash type.
 # has_ref, has_drift = 0: the run has no reference error / no drift; the
 # panel says so instead of plotting.
-# Writes out.png and out.svg.
+# Writes out.png and out.svg; formats = "png"
+# (what `cstab report` passes unless --svg) writes out.png alone.
 if (!exists("data") || !exists("out")) {
   print "usage: gnuplot -e \"data='wp.dat'; out='basename'\" work_precision.gp"
   exit status 2
@@ -43,7 +44,8 @@ empty_panel(msg) = sprintf("set label 99 '%s' at graph 0.5, 0.5 center noenhance
 
 # Four panels in the left 80 %, the legend in the right strip.
 W = 0.40; H = 0.455
-do for [fmt in "png svg"] {
+if (!exists("formats")) formats = "png svg"
+do for [fmt in formats] {
   if (fmt eq "png") { set terminal pngcairo enhanced size 1600,1100 font "DejaVu Sans,11" } \
   else { set terminal svg enhanced size 1600,1100 font "DejaVu Sans,11" dynamic background "#ffffff" }
   set output out.".".fmt

@@ -17,6 +17,7 @@
 
 #include "core/format.hpp"
 #include "io/csv.hpp"
+#include "io/gzip.hpp"
 #include "io/hash.hpp"
 #include "io/number.hpp"
 #include "io/text.hpp"
@@ -50,33 +51,6 @@ std::string seconds_text(double s) {
   else
     std::snprintf(buf, sizeof buf, "%.3g s", s);
   return buf;
-}
-
-std::string base64(const std::string& data) {
-  static const char* table = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-  std::string out;
-  out.reserve((data.size() + 2) / 3 * 4);
-  size_t i = 0;
-  for (; i + 2 < data.size(); i += 3) {
-    const unsigned v = (unsigned char)data[i] << 16 | (unsigned char)data[i + 1] << 8 | (unsigned char)data[i + 2];
-    out += table[v >> 18];
-    out += table[(v >> 12) & 63];
-    out += table[(v >> 6) & 63];
-    out += table[v & 63];
-  }
-  if (i + 1 == data.size()) {
-    const unsigned v = (unsigned char)data[i] << 16;
-    out += table[v >> 18];
-    out += table[(v >> 12) & 63];
-    out += "==";
-  } else if (i + 2 == data.size()) {
-    const unsigned v = (unsigned char)data[i] << 16 | (unsigned char)data[i + 1] << 8;
-    out += table[v >> 18];
-    out += table[(v >> 12) & 63];
-    out += table[(v >> 6) & 63];
-    out += '=';
-  }
-  return out;
 }
 
 // A finished case with a timing: a point of the work-precision pictures and tables.
@@ -237,15 +211,24 @@ double cell(const std::vector<std::string>& row, int col) {
 // A case's series (series.csv.gz or series.csv); empty if it is missing or unreadable.
 CsvTable read_series(const std::string& dir, const CaseResult& c) { return load_case_series(dir, *c.entry); }
 
-// Overlay data: per run, t, max |residual|, |drift|. Colours in `lcs`.
+// Records that the pictures read columns `cols` of case `c`'s series `s`.
+void note_use(SeriesUse& used, const CaseResult& c, const CsvTable& s, const std::vector<int>& cols) {
+  for (int col : cols) used[c.entry->id].insert(s.header[col]);
+}
+
+// Overlay data: per run, t, max |residual|, |drift|. Colours in `lcs`; the
+// columns read in `used`.
 std::string overlay_data(const std::string& dir, const std::vector<const CaseResult*>& runs,
-                         const std::map<std::string, int>& colour, std::string& lcs, bool& has_drift) {
+                         const std::map<std::string, int>& colour, std::string& lcs, bool& has_drift,
+                         SeriesUse& used) {
   std::string out;
   has_drift = false;
   for (const CaseResult* c : runs) {
     const CsvTable s = read_series(dir, *c);
     if (s.rows.empty()) continue;  // missing or unreadable: the run is left out
     const SeriesColumns cols = classify(s);
+    note_use(used, *c, s, cols.residuals);
+    note_use(used, *c, s, cols.drifts);
     has_drift = has_drift || !cols.drifts.empty();
     if (!out.empty()) out += "\n\n";
     out += quoted_header(run_label(*c), {"max_abs_residual", "abs_drift"});
@@ -261,10 +244,11 @@ std::string overlay_data(const std::string& dir, const std::vector<const CaseRes
 }
 
 // Trajectory data: per run, t and the position coordinates (names not
-// ending in "dot"; at most 9). Colours in `lcs`, coordinate names in `names`.
+// ending in "dot"; at most 9). Colours in `lcs`, coordinate names in
+// `names`, the columns read in `used`.
 std::string trajectory_data(const std::string& dir, const std::vector<const CaseResult*>& runs,
                             const std::map<std::string, int>& colour, std::string& lcs,
-                            std::vector<std::string>& names) {
+                            std::vector<std::string>& names, SeriesUse& used) {
   std::string out;
   for (const CaseResult* c : runs) {
     const CsvTable s = read_series(dir, *c);
@@ -277,6 +261,7 @@ std::string trajectory_data(const std::string& dir, const std::vector<const Case
     }
     if (shown.empty()) shown = cols.coords;
     if (shown.size() > 9) shown.resize(9);
+    note_use(used, *c, s, shown);
     std::vector<std::string> these;
     for (int col : shown) these.push_back(s.header[col]);
     if (out.empty()) names = these;
@@ -297,33 +282,43 @@ std::string trajectory_data(const std::string& dir, const std::vector<const Case
   return out;
 }
 
-// Runs the jobs, `jobs` gnuplot processes at a time; returns failures.
+// Starts gnuplot on `job` (output and errors to plots/data/NAME.log), PNG
+// only or PNG and SVG (opt.svg); the child's pid, < 0 if it cannot start.
+pid_t start_gnuplot(const PlotJob& job, const std::string& scripts, const std::string& plot_dir,
+                    const ReportOptions& opt) {
+  const std::string script = scripts + "/" + job.script;
+  const std::string vars = job.vars + "; formats=" + gnuplot_string(opt.svg ? "png svg" : "png");
+  const std::string log_path = plot_dir + "/data/" + job.name + ".log";
+  std::fflush(nullptr);
+  const pid_t pid = ::fork();
+  if (pid == 0) {
+    std::FILE* log = std::fopen(log_path.c_str(), "w");
+    if (log) {
+      ::dup2(::fileno(log), 1);
+      ::dup2(::fileno(log), 2);
+    }
+    ::execlp("gnuplot", "gnuplot", "-e", vars.c_str(), script.c_str(), (char*)nullptr);
+    ::_exit(127);
+  }
+  return pid;
+}
+
+// Runs the jobs, `opt.jobs` gnuplot processes at a time; returns failures.
+// A failed job's picture files go (an empty or partial PNG is no picture).
 std::vector<std::string> run_gnuplot(const std::vector<PlotJob>& todo, const std::string& scripts,
-                                     const std::string& plot_dir, int jobs, std::set<std::string>& drawn) {
+                                     const std::string& plot_dir, const ReportOptions& opt,
+                                     std::set<std::string>& drawn) {
   std::vector<std::string> failures;
   std::map<pid_t, const PlotJob*> running;
   size_t next = 0;
   while (next < todo.size() || !running.empty()) {
-    while (running.size() < size_t(std::max(1, jobs)) && next < todo.size()) {
+    while (running.size() < size_t(std::max(1, opt.jobs)) && next < todo.size()) {
       const PlotJob& job = todo[next++];
-      const std::string script = scripts + "/" + job.script;
-      const std::string log_path = plot_dir + "/data/" + job.name + ".log";
-      std::fflush(nullptr);
-      const pid_t pid = ::fork();
-      if (pid == 0) {
-        std::FILE* log = std::fopen(log_path.c_str(), "w");
-        if (log) {
-          ::dup2(::fileno(log), 1);
-          ::dup2(::fileno(log), 2);
-        }
-        ::execlp("gnuplot", "gnuplot", "-e", job.vars.c_str(), script.c_str(), (char*)nullptr);
-        ::_exit(127);
-      }
-      if (pid < 0) {
+      const pid_t pid = start_gnuplot(job, scripts, plot_dir, opt);
+      if (pid < 0)
         failures.push_back(job.name + ": cannot start gnuplot");
-        continue;
-      }
-      running[pid] = &job;
+      else
+        running[pid] = &job;
     }
     int status = 0;
     const pid_t pid = ::waitpid(-1, &status, 0);
@@ -333,11 +328,14 @@ std::vector<std::string> run_gnuplot(const std::vector<PlotJob>& todo, const std
     const PlotJob& job = *it->second;
     running.erase(it);
     const bool ok = WIFEXITED(status) && WEXITSTATUS(status) == 0 && fs::exists(plot_dir + "/" + job.name + ".png");
-    if (ok) drawn.insert(job.name);
-    if (!ok) {
-      std::string why = WIFEXITED(status) && WEXITSTATUS(status) == 127 ? "gnuplot not found" : "gnuplot failed";
-      failures.push_back(job.name + ": " + why + " (see " + plot_dir + "/data/" + job.name + ".log)");
+    if (ok) {
+      drawn.insert(job.name);
+      continue;
     }
+    std::error_code ec;
+    for (const char* ext : {".png", ".svg"}) fs::remove(plot_dir + "/" + job.name + ext, ec);
+    const char* why = WIFEXITED(status) && WEXITSTATUS(status) == 127 ? "gnuplot not found" : "gnuplot failed";
+    failures.push_back(job.name + ": " + why + " (see " + plot_dir + "/data/" + job.name + ".log)");
   }
   return failures;
 }
@@ -475,12 +473,15 @@ struct PlotSet {
   std::string plot_dir;
   std::vector<PlotJob> jobs;
   std::map<std::string, std::string> captions;
-  std::set<std::string> series_used;  // case ids whose series the pictures read
-  // Writes plots/data/<name>.dat and queues the job; returns the name.
+  SeriesUse series_used;  // the series the pictures read: case id -> columns
+  // Writes plots/data/<name>.dat.gz (gzip, read by the scripts through
+  // gzip -dc; style.gp) and queues the job; returns the name.
   std::string add(const std::string& name, const std::string& script, const std::string& data,
                   const std::string& extra_vars, const std::string& caption) {
-    const std::string data_path = plot_dir + "/data/" + name + ".dat";
-    write_file_atomic(data_path, data);
+    const std::string data_path = plot_dir + "/data/" + name + ".dat.gz";
+    write_file_atomic(data_path, gzip_compress(data));
+    std::error_code ec;
+    fs::remove(plot_dir + "/data/" + name + ".dat", ec);  // plain, from cstab before issue 16
     jobs.push_back({name, script,
                     "data=" + gnuplot_string(data_path) + "; out=" + gnuplot_string(plot_dir + "/" + name) + extra_vars,
                     data, caption});
@@ -564,8 +565,8 @@ void add_overlay_plot(PlotSet& plots, const std::string& dir, ProblemView& p, co
                       const std::vector<const CaseResult*>& overlay) {
   std::string lcs;
   bool has_drift = false;
-  const std::string text = overlay_data(dir, overlay, style.colour, lcs, has_drift);
-  for (const CaseResult* c : overlay) plots.series_used.insert(c->entry->id);
+  for (const CaseResult* c : overlay) plots.series_used[c->entry->id];  // kept even if unread
+  const std::string text = overlay_data(dir, overlay, style.colour, lcs, has_drift, plots.series_used);
   if (text.empty()) return;
   std::string who;
   for (const CaseResult* c : overlay) who += (who.empty() ? "" : "; ") + run_label(*c);
@@ -585,8 +586,8 @@ void add_trajectory_plot(PlotSet& plots, const std::string& dir, ProblemView& p,
   std::string lcs;
   std::vector<std::string> names;
   const auto trajectory = trajectory_runs(dir, p, overlay);
-  const std::string text = trajectory_data(dir, trajectory, style.colour, lcs, names);
-  for (const CaseResult* c : trajectory) plots.series_used.insert(c->entry->id);
+  for (const CaseResult* c : trajectory) plots.series_used[c->entry->id];  // kept even if unread
+  const std::string text = trajectory_data(dir, trajectory, style.colour, lcs, names, plots.series_used);
   if (text.empty()) return;
   std::string joined, who;
   for (const auto& n : names) joined += (joined.empty() ? "" : " ") + n;
@@ -616,20 +617,31 @@ std::vector<std::string> plan_stress_plots(PlotSet& plots, const StressSection& 
   return names;
 }
 
-// plots/replot.sh: the exact commands, for editing a picture by hand.
+// plots/replot.sh: the exact commands, for editing a picture by hand; it
+// draws PNG and SVG (FORMATS=png: the PNGs alone).
 void write_replot_script(const PlotSet& plots, const std::string& scripts) {
-  std::string sh = "#!/bin/sh\n# Redraws the pictures of this results folder (written by cstab report).\nset -e\n";
+  std::string sh = "#!/bin/sh\n# Redraws the pictures of this results folder (written by cstab report) as PNG\n"
+                   "# and SVG; FORMATS=png sh replot.sh draws the PNGs alone.\nset -e\n";
   sh += "PLOTS=${CSTAB_PLOTS:-" + (scripts.empty() ? std::string("plots") : scripts) + "}\n";
+  sh += "FORMATS=${FORMATS:-png svg}\n";
   for (const auto& j : plots.jobs) {
     std::string q;
     for (char c : j.vars) q += c == '"' ? std::string("\\\"") : std::string(1, c);
-    sh += "gnuplot -e \"" + q + "\" \"$PLOTS/" + j.script + "\"\n";
+    sh += "gnuplot -e \"" + q + "; formats='$FORMATS'\" \"$PLOTS/" + j.script + "\"\n";
   }
   write_file_atomic(plots.plot_dir + "/replot.sh", sh);
 }
 
-// Runs gnuplot for every picture whose stamp (script, style, variables, data) changed.
-void draw_plots(const PlotSet& plots, const std::string& scripts, int jobs, ReportResult& result) {
+// Whether job `j`'s pictures are there: the PNG, and the SVG if asked for.
+bool pictures_exist(const std::string& plot_dir, const PlotJob& j, bool svg) {
+  const std::string base = plot_dir + "/" + j.name;
+  return fs::exists(base + ".png") && (!svg || fs::exists(base + ".svg"));
+}
+
+// Runs gnuplot for every picture whose stamp (script, style, variables, data)
+// changed or whose files are missing. An SVG is drawn only with opt.svg; a
+// picture redrawn without it loses its old SVG (it would no longer match).
+void draw_plots(const PlotSet& plots, const std::string& scripts, const ReportOptions& opt, ReportResult& result) {
   if (scripts.empty()) {
     result.warnings.push_back("gnuplot scripts not found (set CSTAB_PLOTS to the plots/ folder): no pictures");
     return;
@@ -643,16 +655,16 @@ void draw_plots(const PlotSet& plots, const std::string& scripts, int jobs, Repo
   std::error_code ec;
   for (const auto& j : plots.jobs) {
     const std::string stamp_path = plot_dir + "/data/" + j.name + ".stamp";
-    if (file_or_empty(stamp_path) == stamp_of(j) && fs::exists(plot_dir + "/" + j.name + ".png") &&
-        fs::exists(plot_dir + "/" + j.name + ".svg")) {
+    if (file_or_empty(stamp_path) == stamp_of(j) && pictures_exist(plot_dir, j, opt.svg)) {
       ++result.plots_reused;
       continue;
     }
     fs::remove(stamp_path, ec);
+    if (!opt.svg) fs::remove(plot_dir + "/" + j.name + ".svg", ec);
     todo.push_back(j);
   }
   std::set<std::string> drawn;
-  for (const auto& f : run_gnuplot(todo, scripts, plot_dir, jobs, drawn)) result.warnings.push_back(f);
+  for (const auto& f : run_gnuplot(todo, scripts, plot_dir, opt, drawn)) result.warnings.push_back(f);
   for (const auto& j : todo) {
     if (!drawn.count(j.name)) continue;
     ++result.plots_drawn;
@@ -788,13 +800,19 @@ void html_fastest_row(std::ostream& h, const ProblemView& p, const Measure& m, d
   h << "<td class=\"num\">" << ranked.size() << " of " << p.curves.size() << "</td></tr>\n";
 }
 
-// A drawn picture, inlined as PNG, with its caption; nothing if it was not drawn.
+// A drawn picture, linked (plots/NAME.png beside report.html), with its
+// caption; nothing if it was not drawn (no PNG, or an empty one).
 void html_figure(std::ostream& h, const PlotSet& plots, const std::string& name) {
-  const std::string png = file_or_empty(plots.plot_dir + "/" + name + ".png");
-  if (png.empty()) return;
-  h << "<figure><img alt=\"" << html_escape(name) << "\" src=\"data:image/png;base64," << base64(png)
-    << "\"><figcaption>" << html_escape(plots.captions.at(name)) << " Files: <code>plots/" << html_escape(name)
-    << ".png</code>, <code>plots/" << html_escape(name) << ".svg</code>.</figcaption></figure>\n";
+  const std::string base = plots.plot_dir + "/" + name;
+  std::error_code ec;
+  const auto bytes = fs::file_size(base + ".png", ec);
+  if (ec || bytes == 0) return;
+  const std::string file = "plots/" + url_path_escape(name);
+  h << "<figure><img alt=\"" << html_escape(name) << "\" src=\"" << file << ".png\"><figcaption>"
+    << html_escape(plots.captions.at(name)) << " Files: <code>plots/" << html_escape(name) << ".png</code>, "
+    << (fs::exists(base + ".svg") ? "<code>plots/" + html_escape(name) + ".svg</code>"
+                                  : std::string("SVG by <code>cstab report --svg</code>"))
+    << ".</figcaption></figure>\n";
 }
 
 // Per problem: the fastest method at each accuracy level, then its pictures.
@@ -918,9 +936,9 @@ ReportResult build_report(const std::string& dir, const ReportOptions& opt, std:
   // replot.sh, then gnuplot for what changed.
   const std::string scripts = opt.plot_scripts.empty() ? find_plot_scripts() : opt.plot_scripts;
   write_replot_script(plots, scripts);
-  if (opt.plots) draw_plots(plots, scripts, opt.jobs, result);
+  if (opt.plots) draw_plots(plots, scripts, opt, result);
   result.series_used = plots.series_used;
-  result.series_used.insert(stress.series_used.begin(), stress.series_used.end());
+  for (const auto& [id, columns] : stress.series_used) result.series_used[id].insert(columns.begin(), columns.end());
   // report.html.
   const Provenance prov = parse_provenance(file_or_empty(dir + "/provenance.txt"));
   const Page page{dir, folder.cases, problems, stress, stress_plots, plots, prov, result.warnings};

@@ -1,7 +1,8 @@
 // What a results folder turns into: the work-precision table, the fastest
-// method per accuracy level, the gnuplot pictures and one self-contained
-// HTML page. Everything is derived from DIR/cases.csv, DIR/summary.csv and
-// the case folders, so `cstab report DIR` can rebuild it at any time.
+// method per accuracy level, the gnuplot pictures and one HTML page that
+// shows them (linked from plots/, so report.html goes with its folder).
+// Everything is derived from DIR/cases.csv, DIR/summary.csv and the case
+// folders, so `cstab report DIR` can rebuild it at any time.
 //
 //   DIR/work_precision.csv   one row per work-precision case (tidy):
 //       problem, curve, method, formulation, integrator, params, setting,
@@ -16,9 +17,10 @@
 //       that reaches it, ranked by the wall time of its fastest case
 //       (columns problem, measure, threshold, rank, curve, method,
 //       integrator, case_id, setting, wall_median_s, value, ratio_to_fastest)
-//   DIR/plots/<problem>_{work_precision,overlay,trajectory}.{png,svg}
-//   DIR/plots/data/*.dat     the plotted data; DIR/plots/replot.sh redraws
-//   DIR/report.html          tables, every picture inlined, provenance
+//   DIR/plots/<problem>_{work_precision,overlay,trajectory}.png (and .svg
+//       with ReportOptions::svg, `cstab report --svg`, or plots/replot.sh)
+//   DIR/plots/data/*.dat.gz  the plotted data (gzip); DIR/plots/replot.sh redraws
+//   DIR/report.html          tables, every picture (plots/*.png), provenance
 #pragma once
 
 #include <iosfwd>
@@ -26,11 +28,14 @@
 #include <string>
 #include <vector>
 
+#include "matrix/matrix.hpp"
+
 namespace cstab {
 
 struct ReportOptions {
   int jobs = 1;               // gnuplot processes at a time
   bool plots = true;          // false: tables and HTML only
+  bool svg = false;           // also draw every picture as SVG (plots/<name>.svg)
   std::string plot_scripts;   // folder of the gnuplot scripts; empty: find_plot_scripts()
 };
 
@@ -39,8 +44,9 @@ struct ReportResult {
   size_t plots_drawn = 0, plots_reused = 0;
   std::vector<std::string> warnings;
   // The cases whose series the pictures read (overlays, trajectories, long
-  // horizons): what `cstab matrix` keeps when it drops the other series.
-  std::set<std::string> series_used;
+  // horizons), each with the columns read: what `cstab matrix` keeps when
+  // it drops the other series (shrink_series).
+  SeriesUse series_used;
 };
 
 // Needs DIR/summary.csv (write_matrix_summary). A picture whose data and

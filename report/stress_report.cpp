@@ -208,10 +208,11 @@ struct LongPlots {
 };
 
 // The running max |E - E0| of a finished case from its series (decimated rows).
-void add_long_series(LongPlots& plots, const std::string& dir, const CaseResult& c) {
+void add_long_series(LongPlots& plots, const std::string& dir, const CaseResult& c, SeriesUse& used) {
   if (c.status != Status::kOk) return;
   const CsvTable series = load_case_series(dir, *c.entry);
   if (series.column("t") < 0 || series.column("energy_drift") < 0) return;
+  used[c.entry->id].insert({"t", "energy_drift"});
   const std::string& sweep = c.entry->sweep;
   add_once(plots.sweeps, sweep);
   std::string& data = plots.data[sweep];
@@ -244,8 +245,8 @@ void long_section(std::ostream& h, const ResultsFolder& folder, const Cases& lon
   LongPlots plots;
   for (const CaseResult* c : long_runs) {
     csv += long_row(h, *c, integrals);
-    add_long_series(plots, folder.dir, *c);
-    out.series_used.insert(c->entry->id);
+    out.series_used[c->entry->id];  // kept even if unread
+    add_long_series(plots, folder.dir, *c, out.series_used);
   }
   h << "</table>\n";
   write_file_atomic(folder.dir + "/stress_long.csv", csv);

@@ -30,7 +30,7 @@ namespace cstab {
 struct StressPlot {
   std::string name;     // basename under DIR/plots
   std::string script;   // gnuplot script in plots/
-  std::string data;     // contents of DIR/plots/data/<name>.dat
+  std::string data;     // contents of DIR/plots/data/<name>.dat(.gz)
   std::string vars;     // extra gnuplot -e assignments ("; a=...")
   std::string caption;
 };
@@ -39,7 +39,7 @@ struct StressSection {
   bool empty = true;
   std::string html;              // tables (pictures are added by the report)
   std::vector<StressPlot> plots;
-  std::set<std::string> series_used;  // case ids whose series the pictures read
+  SeriesUse series_used;  // the series the pictures read: case id -> columns
 };
 
 // From the cases of a results folder; writes DIR/stress_*.csv for what it finds.

@@ -165,6 +165,8 @@ cases=(
 "mat_out_proc|matrix $M/good.toml --out /proc/x"
 "mat_unknown_flag|matrix $M/good.toml --frobnicate --out OUT"
 "mat_filter_nothing|matrix $M/good.toml --filter nothing-matches --out OUT"
+"mat_svg_no_report|matrix $M/good.toml --svg --no-report --out OUT"
+"mat_svg_shard|matrix $M/good.toml --svg --shard 1/2 --out OUT"
 )
 for f in $M/*.toml; do n=$(basename $f .toml); [ $n = good ] && continue; cases+=("matfile_$n|matrix $f --out OUT"); done
 cases+=(
@@ -180,6 +182,8 @@ cases+=(
 "report_missing|report /nonexistent"
 "report_jobs_zero|report SHARD --jobs 0"
 "report_two|report SHARD SHARD"
+"report_svg_no_plots|report SHARD --svg --no-plots"
+"merge_svg_no_report|merge OUT SHARD --svg --no-report"
 "list_extra|list extra"
 "i16_run_step_1e-320|run --problem slider-crank --method pesterev --integrator rk4 --step 1e-320 --t-end 0.1 --out OUT"
 "i16_run_t_end_1e9_step_1e-9|run --problem slider-crank --method pesterev --integrator rk4 --step 1e-9 --t-end 1e9 --out OUT"

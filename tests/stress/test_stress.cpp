@@ -322,4 +322,34 @@ TEST(ReportText, EscapersQuotersAndCells) {
   EXPECT_EQ(cstab::log_plot_cell(0), "?");
   EXPECT_EQ(cstab::log_plot_cell(-1), "?");
   EXPECT_EQ(cstab::log_plot_cell(2.5), "2.5");
+  EXPECT_EQ(cstab::url_path_escape("wheel_overlay.png"), "wheel_overlay.png");
+  EXPECT_EQ(cstab::url_path_escape("stress_a b#1?%\"<"), "stress_a%20b%231%3F%25%22%3C");
+}
+
+// A series kept for the pictures holds the columns they read (the first
+// always), in order; a row's missing cells stay missing.
+TEST(ReportText, CsvSelectColumnsKeepsTheFirstAndTheNamedOnes) {
+  const std::string csv = "t,x,xdot,residual_a,cond\n0,1,2,3,4\n0.5,1.5,,3.5\n1\n";
+  EXPECT_EQ(cstab::csv_select_columns(csv, {"residual_a", "x", "nope"}), "t,x,residual_a\n0,1,3\n0.5,1.5,3.5\n1\n");
+  EXPECT_EQ(cstab::csv_select_columns(csv, {"xdot"}), "t,xdot\n0,2\n0.5,\n1\n");
+  EXPECT_EQ(cstab::csv_select_columns(csv, {}), csv);
+  EXPECT_EQ(cstab::csv_select_columns("t,x\n,7", {"x"}), "t,x\n,7");  // an empty first cell; no final newline
+}
+
+// ... and its numbers at plot precision: numbers to
+// 7 digits, everything else and the header as they were; the pictures'
+// cells of the rounded numbers are those of the exact ones.
+TEST(ReportText, CsvAtPlotPrecisionRoundsOnlyTheNumbersOfTheRows) {
+  const std::string exact =
+      "t,x_1e-3,residual_a\n0,0.10000000000000001,-1.2345678901234567e-12\n"
+      "0.0030000000000000001,,nan\n1e-320,inf,text\n";
+  const std::string rounded = cstab::csv_at_plot_precision(exact);
+  EXPECT_EQ(rounded, "t,x_1e-3,residual_a\n0,0.1,-1.234568e-12\n0.003,,nan\n9.999889e-321,inf,text\n");
+  EXPECT_EQ(cstab::csv_at_plot_precision(rounded), rounded);
+  EXPECT_EQ(cstab::csv_at_plot_precision("t,x\n1.23456789,2"), "t,x\n1.234568,2");  // no final newline
+  EXPECT_EQ(cstab::csv_at_plot_precision("t,x\n"), "t,x\n");
+  for (double v : {0.1, -1.2345678901234567e-12, 123456.789012345, 1e-320, 6.02214076e23}) {
+    const std::string cell = cstab::csv_at_plot_precision("h\n" + cstab::number_cell(v)).substr(2);
+    EXPECT_EQ(cstab::plot_cell(cstab::parse_number(cell)), cstab::plot_cell(v)) << v;
+  }
 }

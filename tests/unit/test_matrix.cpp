@@ -469,9 +469,14 @@ TEST_F(MatrixRun, SingleRunWritesResultsPlotsAndReport) {
   ASSERT_EQ(single_.code, 0) << single_.out;
   EXPECT_NE(single_.out.find("10 cases: 10 run, 0 cached, in "), std::string::npos) << single_.out;
   for (const char* f : {"summary.csv", "cases.csv", "matrix.toml", "provenance.txt", "work_precision.csv",
-                        "fastest.csv", "report.html", "plots/wheel_work_precision.png", "plots/wheel_work_precision.svg",
-                        "plots/wheel_overlay.png", "plots/wheel_trajectory.svg"})
+                        "fastest.csv", "report.html", "plots/wheel_work_precision.png", "plots/wheel_overlay.png",
+                        "plots/wheel_trajectory.png", "plots/replot.sh", "plots/data/wheel_overlay.dat.gz"})
     EXPECT_TRUE(fs::exists(dir_ + "/single/" + f)) << f;
+  // SVGs only on demand (ReportPicturesOnDemand); the plotted data gzip-compressed.
+  for (const auto& e : fs::directory_iterator(dir_ + "/single/plots"))
+    EXPECT_NE(e.path().extension(), ".svg") << e.path();
+  for (const auto& e : fs::directory_iterator(dir_ + "/single/plots/data"))
+    EXPECT_NE(e.path().extension(), ".dat") << e.path();
   const CsvTable s = read_csv(dir_ + "/single/summary.csv");
   EXPECT_EQ(s.header[0], "case_id");
   EXPECT_EQ(s.header[1], "repeat");
@@ -482,7 +487,9 @@ TEST_F(MatrixRun, SingleRunWritesResultsPlotsAndReport) {
                           "date: "})
     EXPECT_NE(prov.find(key), std::string::npos) << key;
   const std::string html = slurp(dir_ + "/single/report.html");
-  EXPECT_NE(html.find("data:image/png;base64,"), std::string::npos);
+  // The pictures are linked from plots/, not inlined.
+  EXPECT_NE(html.find("<img alt=\"wheel_overlay\" src=\"plots/wheel_overlay.png\">"), std::string::npos);
+  EXPECT_EQ(html.find("data:image"), std::string::npos);
   EXPECT_NE(html.find("Fastest method at each accuracy level"), std::string::npos);
 }
 
@@ -520,6 +527,61 @@ TEST_F(MatrixRun, TwoShardsThroughGnuParallelMergeToTheSingleRun) {
   // A missing shard is reported, with exit code 3.
   const Outcome partial = sh(std::string(CSTAB_BINARY) + " merge " + dir_ + "/partial " + dir_ + "/shard1 --no-report");
   EXPECT_EQ(partial.code, 3) << partial.out;
+}
+
+// The pictures' names in a folder's plots/ with the given extension.
+std::set<std::string> pictures(const std::string& plots, const std::string& ext) {
+  std::set<std::string> names;
+  for (const auto& e : fs::directory_iterator(plots))
+    if (e.path().extension() == ext) names.insert(e.path().stem().string());
+  return names;
+}
+
+// SVGs on demand: `cstab report --svg` draws one per PNG, a plain report
+// keeps them while nothing changed; plots/replot.sh redraws both formats,
+// and the PNGs it draws are the ones cstab drew.
+// (The sweep "fixed" alone: the tiny matrix's "long" sweep is too short for
+// its drift picture, whose gnuplot fails.)
+TEST_F(MatrixRun, ReportPicturesOnDemand) {
+  const std::string dir = dir_ + "/svg", plots = dir + "/plots";
+  Outcome o = sh(std::string(CSTAB_BINARY) + " matrix " + dir_ + "/tiny.toml --filter fixed --out " + dir);
+  ASSERT_EQ(o.code, 0) << o.out;
+  const std::set<std::string> png = pictures(plots, ".png");
+  EXPECT_EQ(png, (std::set<std::string>{"wheel_overlay", "wheel_trajectory", "wheel_work_precision"}));
+  EXPECT_TRUE(pictures(plots, ".svg").empty());
+  o = sh(std::string(CSTAB_BINARY) + " report " + dir + " --svg");
+  ASSERT_EQ(o.code, 0) << o.out;
+  EXPECT_NE(o.out.find("(" + std::to_string(png.size()) + " plots drawn, 0 unchanged)"), std::string::npos) << o.out;
+  EXPECT_EQ(pictures(plots, ".svg"), png);
+  EXPECT_NE(slurp(dir + "/report.html").find("<code>plots/wheel_overlay.svg</code>"), std::string::npos);
+  o = sh(std::string(CSTAB_BINARY) + " report " + dir);
+  ASSERT_EQ(o.code, 0) << o.out;
+  EXPECT_NE(o.out.find("(0 plots drawn, " + std::to_string(png.size()) + " unchanged)"), std::string::npos) << o.out;
+  EXPECT_EQ(pictures(plots, ".svg"), png);
+  // replot.sh: the same PNGs, and the SVGs again after they were removed.
+  const std::string first = slurp(plots + "/wheel_overlay.png");
+  for (const auto& name : png) fs::remove(plots + "/" + name + ".svg");
+  o = sh("sh " + plots + "/replot.sh");
+  ASSERT_EQ(o.code, 0) << o.out;
+  EXPECT_EQ(pictures(plots, ".svg"), png);
+  EXPECT_EQ(slurp(plots + "/wheel_overlay.png"), first);
+  // Without --svg, a redrawn picture loses its SVG (it would be stale).
+  fs::remove(plots + "/data/wheel_overlay.stamp");
+  o = sh(std::string(CSTAB_BINARY) + " report " + dir);
+  ASSERT_EQ(o.code, 0) << o.out;
+  EXPECT_FALSE(fs::exists(plots + "/wheel_overlay.svg"));
+  EXPECT_TRUE(fs::exists(plots + "/wheel_trajectory.svg"));
+  // --svg where nothing is drawn is bad input, and changes nothing.
+  for (const std::string& bad : {" report " + dir + " --svg --no-plots", " merge " + dir_ + "/svg2 " + dir +
+                                                                          " --svg --no-report"}) {
+    o = sh(std::string(CSTAB_BINARY) + bad);
+    EXPECT_EQ(o.code, 2) << bad << "\n" << o.out;
+    EXPECT_NE(o.out.find("--svg: draws the pictures; not with --no-"), std::string::npos) << o.out;
+  }
+  EXPECT_FALSE(fs::exists(dir_ + "/svg2"));
+  o = sh(std::string(CSTAB_BINARY) + " matrix " + dir_ + "/tiny.toml --out " + dir_ + "/svg3 --shard 1/2 --svg");
+  EXPECT_EQ(o.code, 2) << o.out;
+  EXPECT_FALSE(fs::exists(dir_ + "/svg3"));
 }
 
 TEST_F(MatrixRun, ReportOpensInHeadlessChromiumWithEveryImageLoaded) {

@@ -18,11 +18,14 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <set>
 #include <string>
 #include <thread>
 #include <vector>
 
 #include "core/params.hpp"
+#include "io/csv.hpp"
+#include "io/gzip.hpp"
 #include "io/lock.hpp"
 #include "io/number.hpp"
 #include "matrix/matrix.hpp"
@@ -504,7 +507,7 @@ size_t series_files(const fs::path& dir) {
   return n;
 }
 
-TEST_F(Folder, TheMatrixKeepsOnlyTheSeriesThePicturesReadAndKeepSeriesBringsThemBack) {
+TEST_F(Folder, TheMatrixKeepsOnlyWhatThePicturesReadAndKeepSeriesBringsTheWholeSeriesBack) {
   const fs::path dir = copy("series_kept");
   const auto id = ids();
   ASSERT_EQ(id.size(), 4u);
@@ -514,38 +517,65 @@ TEST_F(Folder, TheMatrixKeepsOnlyTheSeriesThePicturesReadAndKeepSeriesBringsThem
   // With the report: pesterev diverges at both steps and none of its runs
   // is marked for the overlays, so no picture reads its series; of
   // baumgarte's two runs, the pictures read the more accurate. The other
-  // three series go.
+  // three series go; the one kept is cut to the columns the pictures read,
+  // at plot precision.
   Outcome o = cstab_cmd(with_report);
   ASSERT_EQ(o.code, 0) << o.out;
   EXPECT_TRUE(contains(o.out, "4 of 4 cases cached")) << o.out;
   EXPECT_TRUE(contains(o.out, "dropped 3 others")) << o.out;
+  EXPECT_TRUE(contains(o.out, "cut the 1 series the pictures read to their columns and 7 digits")) << o.out;
   EXPECT_EQ(series_files(dir), 1u);
   size_t dropped = 0;
   for (const auto& i : id) {
     const std::string key = slurp(dir / "cases" / i / "key.txt");
-    const bool has = fs::exists(dir / "cases" / i / "series.csv.gz");
+    const fs::path series = dir / "cases" / i / "series.csv.gz";
+    const bool has = fs::exists(series);
     EXPECT_EQ(contains(key, "\nfile series.csv.gz "), has) << key;
     EXPECT_EQ(contains(key, "\ndropped series.csv.gz\n"), !has) << key;
+    EXPECT_EQ(contains(key, "\nfor-pictures series.csv.gz\n"), has) << key;
     dropped += !has;
+    if (!has) continue;
+    // The kept one: t, the positions the trajectories show, the residuals
+    // and the energy drift the overlay shows; the whole series' numbers at
+    // 7 digits.
+    const std::string whole = cstab::gzip_decompress(slurp(shard() / "cases" / i / "series.csv.gz"), 1 << 26);
+    const std::string cut = cstab::gzip_decompress(slurp(series), 1 << 26);
+    EXPECT_EQ(cut.substr(0, cut.find('\n')), "t,x,z,theta,phi,alpha,residual_distance,residual_rolling,energy_drift");
+    const std::set<std::string> read = {"x", "z", "theta", "phi", "alpha", "residual_distance", "residual_rolling",
+                                        "energy_drift"};
+    EXPECT_TRUE(cut == cstab::csv_at_plot_precision(cstab::csv_select_columns(whole, read)));
+    EXPECT_LT(fs::file_size(series), fs::file_size(shard() / "cases" / i / "series.csv.gz") / 2);
   }
   EXPECT_EQ(dropped, 3u);
-  // The report rebuilt from the folder picks the same runs.
-  const std::string trajectory = slurp(dir / "plots" / "data" / "wheel_trajectory.dat");
+  // The report rebuilt from the folder picks the same runs and draws the
+  // same pictures from the rounded series: the same data, nothing redrawn.
+  auto plot_data = [&](const std::string& name) {
+    return cstab::gzip_decompress(slurp(dir / "plots" / "data" / (name + ".dat.gz")), 1 << 26);
+  };
+  const std::string trajectory = plot_data("wheel_trajectory"), overlay = plot_data("wheel_overlay");
   ASSERT_FALSE(trajectory.empty());
+  ASSERT_FALSE(overlay.empty());
   o = cstab_cmd("report " + quote(dir));
   ASSERT_EQ(o.code, 0) << o.out;
-  EXPECT_EQ(slurp(dir / "plots" / "data" / "wheel_trajectory.dat"), trajectory);
-  // Dropped series are still cached results, and nothing more goes.
+  EXPECT_EQ(plot_data("wheel_trajectory"), trajectory);
+  EXPECT_EQ(plot_data("wheel_overlay"), overlay);
+  EXPECT_TRUE(contains(o.out, "(0 plots drawn, ")) << o.out;
+  // Dropped and cut series are still cached results, and nothing more goes
+  // or is cut again.
   o = cstab_cmd(with_report);
   ASSERT_EQ(o.code, 0) << o.out;
   EXPECT_TRUE(contains(o.out, "4 of 4 cases cached")) << o.out;
   EXPECT_FALSE(contains(o.out, "dropped")) << o.out;
-  // --keep-series reruns exactly the cases whose series went.
+  EXPECT_FALSE(contains(o.out, "cut the")) << o.out;
+  // --keep-series reruns exactly the cases whose series went or were cut.
   o = cstab_cmd(with_report + " --keep-series");
   ASSERT_EQ(o.code, 0) << o.out;
   EXPECT_TRUE(contains(o.out, "its series was dropped by an earlier run")) << o.out;
-  EXPECT_TRUE(contains(o.out, "3 run, 1 cached")) << o.out;
+  EXPECT_TRUE(contains(o.out, "its series was cut to the pictures' columns and 7 digits by an earlier run")) << o.out;
+  EXPECT_TRUE(contains(o.out, "4 run, 0 cached")) << o.out;
   EXPECT_EQ(series_files(dir), 4u);
+  for (const auto& i : id)
+    EXPECT_EQ(slurp(dir / "cases" / i / "series.csv.gz"), slurp(shard() / "cases" / i / "series.csv.gz")) << i;
   EXPECT_EQ(cstab::testing::summary_without_timing(dir / "summary.csv"), full);
 }
 
