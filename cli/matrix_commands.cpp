@@ -82,12 +82,12 @@ methods = ["pesterev", "baumgarte", "penalty", "none", "minimal"]
 integrators = ["cvode-bdf"]
 tol = [1e-6, 1e-9]
 
-# The generalized-alpha family and the augmented Lagrangian (ali3p): each
-# method is its own implicit fixed-step scheme (integrator "own"); three
-# steps keep it to seconds per problem.
+# The generalized-alpha family, the augmented Lagrangian (ali3p) and RATTLE
+# (constant-mass holonomic problems): each method is its own fixed-step
+# scheme (integrator "own"); three steps keep it to seconds per problem.
 [[sweep]]
 name = "wp-own"
-methods = ["generalized-alpha", "hht", "generalized-alpha-i2", "ali3p"]
+methods = ["generalized-alpha", "hht", "generalized-alpha-i2", "ali3p", "rattle"]
 integrators = ["own"]
 step = [1e-2, 3e-3, 1e-3]
 
@@ -143,7 +143,7 @@ optional = true
 [[sweep]]
 name = "paper-iftomm-a01-own"
 problems = ["pendulum"]
-methods = ["ali3p"]
+methods = ["ali3p", "rattle"]
 integrators = ["own"]
 step = [1e-3, 1e-4]
 t_end = 2000

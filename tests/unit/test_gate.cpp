@@ -539,6 +539,10 @@ TEST(GateMatrix, DegradedConfigurationsFailForTheRightReason) {
       {"ball", "ali3p", "own", "step=0.001", "ali3p", "", "step=0.01", "max_ref_error", "10x step"},
       {"wheel", "penalty", "rk4", "step=0.001", "penalty", "alpha=1", "step=0.001", "max_residual",
        "penalty factor 1e4 -> 1"},
+      // rattle with a position-solve tolerance of 1e-4: max residual 2.0e-4
+      // against the pendulum's bound 2e-11.
+      {"pendulum", "rattle", "own", "step=0.001", "rattle", "tol=0.0001", "step=0.001", "max_residual",
+       "position solve tolerance 1e-12 -> 1e-4"},
       // (Not here: ali3p with a loose tolerance (tol = 1e-3) stays on the
       // constraints, max residual 4.0e-11 on the ball: its projections, not
       // the tolerance, set the residual. Nor the slider crank with baumgarte
