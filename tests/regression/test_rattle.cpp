@@ -15,6 +15,7 @@
 
 #include "harness/run.hpp"
 #include "problems/registry.hpp"
+#include "tests/support/order_util.hpp"
 #include "tests/support/test_util.hpp"
 
 namespace cstab {
@@ -41,30 +42,12 @@ RunResult run(const std::string& problem, const std::string& method, const std::
   return run_case(find_problem(problem), cfg, "");
 }
 
-// Least-squares slope of log(y) against log(x).
-double log_slope(const std::vector<double>& x, const std::vector<double>& y) {
-  double n = 0, sx = 0, sy = 0, sxx = 0, sxy = 0;
-  for (size_t i = 0; i < x.size(); ++i) {
-    const double lx = std::log(x[i]), ly = std::log(y[i]);
-    n += 1, sx += lx, sy += ly, sxx += lx * lx, sxy += lx * ly;
-  }
-  return (n * sxy - sx * sy) / (n * sxx - sx * sx);
-}
-
 // Observed order of the position and velocity errors at t_end, against a
-// tight run of projection on rk8pd (rtol = atol = 1e-13), h over a decade.
+// tight run (testing::tight_reference), h over a decade.
 void expect_second_order(const std::string& problem, double t_end, double h_max) {
-  RunConfig tight;
-  tight.problem = problem;
-  tight.method = "projection";
-  tight.integrator = "rk8pd";
-  tight.step.rtol = tight.step.atol = 1e-13;
-  tight.t_end = t_end;
-  tight.ref_time = 0;
-  tight.write_series = false;
-  const RunResult ref = run_case(find_problem(problem), tight, "");
-  ASSERT_EQ(ref.status, "ok") << ref.reason;
-  const size_t n = ref.final_state.size(), n_pos = n / 2;
+  const std::vector<double> ref = testing::tight_reference(problem, t_end);
+  ASSERT_FALSE(ref.empty());
+  const size_t n = ref.size(), n_pos = n / 2;
   std::vector<double> hs, pos, vel;
   for (double f : {1.0, 0.5, 0.25, 0.1}) {
     const double h = h_max * f;
@@ -72,14 +55,14 @@ void expect_second_order(const std::string& problem, double t_end, double h_max)
     ASSERT_EQ(r.status, "ok") << problem << " h = " << h << ": " << r.reason;
     double ep = 0, ev = 0;
     for (size_t i = 0; i < n; ++i) {
-      const double d = std::abs(r.final_state[i] - ref.final_state[i]);
+      const double d = std::abs(r.final_state[i] - ref[i]);
       (i < n_pos ? ep : ev) = std::max(i < n_pos ? ep : ev, d);
     }
     hs.push_back(h), pos.push_back(ep), vel.push_back(ev);
     std::cout << "[ order    ] " << problem << " rattle h = " << h << ": position error " << ep << ", velocity error "
               << ev << "\n";
   }
-  const double p = log_slope(hs, pos), v = log_slope(hs, vel);
+  const double p = testing::log_slope(hs, pos), v = testing::log_slope(hs, vel);
   std::cout << "[ order    ] " << problem << " rattle: observed order positions " << p << ", velocities " << v << "\n";
   EXPECT_GE(p, 1.8) << problem;
   EXPECT_LE(p, 2.2) << problem;

@@ -18,20 +18,14 @@
 #include "harness/run.hpp"
 #include "methods/generalized_alpha.hpp"
 #include "problems/registry.hpp"
+#include "tests/support/order_util.hpp"
 #include "tests/support/test_util.hpp"
 
 namespace cstab {
 namespace {
 
-// Least-squares slope of log(y) against log(x).
-double log_slope(const std::vector<double>& x, const std::vector<double>& y) {
-  double n = 0, sx = 0, sy = 0, sxx = 0, sxy = 0;
-  for (size_t i = 0; i < x.size(); ++i) {
-    const double lx = std::log(x[i]), ly = std::log(y[i]);
-    n += 1, sx += lx, sy += ly, sxx += lx * lx, sxy += lx * ly;
-  }
-  return (n * sxy - sx * sy) / (n * sxx - sx * sx);
-}
+using testing::log_slope;
+using testing::tight_reference;
 
 // ---- observed order against the references ----
 
@@ -65,22 +59,6 @@ RunResult run_own(const std::string& problem, const std::string& method, double 
   else
     cfg.params = {{"newton_tol", "1e-13"}, {"newton_iterations", "30"}};
   return run_case(find_problem(problem), cfg, "");
-}
-
-// A tight reference of all canonical coordinates (andrews publishes no
-// rates): projection on rk8pd at rtol = atol = 1e-13.
-std::vector<double> tight_reference(const std::string& problem, double t_end) {
-  RunConfig cfg;
-  cfg.problem = problem;
-  cfg.method = "projection";
-  cfg.integrator = "rk8pd";
-  cfg.step.rtol = cfg.step.atol = 1e-13;
-  cfg.t_end = t_end;
-  cfg.ref_time = 0;
-  cfg.write_series = false;
-  const RunResult r = run_case(find_problem(problem), cfg, "");
-  EXPECT_EQ(r.status, "ok") << r.reason;
-  return r.final_state;
 }
 
 struct OrderCase {
