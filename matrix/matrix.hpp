@@ -192,7 +192,7 @@ struct MatrixRunStats {
 // cache key, a line per result file and the case's summary rows:
 //   problem=wheel                  the case's canonical configuration
 //   ...                            (its hash is the case id)
-//   binary=<16 hex>                the identity of the cstab binary
+//   binary=<size>-<16 hex>         the identity of the cstab binary
 //   file series.csv.gz SIZE HASH   per result file beside it: bytes, 64-bit FNV-1a
 //   for-pictures series.csv.gz     (or `dropped NAME`: shrink_series)
 //   summary SIZE HASH              then SIZE bytes to the end of the file:

@@ -16,6 +16,7 @@
 #include <iostream>
 #include <map>
 #include <memory>
+#include <optional>
 #include <set>
 #include <sstream>
 #include <thread>
@@ -893,8 +894,9 @@ size_t merge_results(const std::string& out_dir, const std::vector<std::string>&
 
 namespace {
 
-// The head of the record (case.txt) of `dir`; nullopt if it is unreadable
-// or not whole (unfinished or damaged: the cache check deals with it).
+// The record (case.txt) of `dir`, split at its `summary` line; nullopt if
+// it is unreadable or not whole (unfinished or damaged: the cache check
+// deals with it).
 std::optional<CaseRecord> read_record(const std::string& dir) {
   try {
     std::string why;

@@ -38,7 +38,7 @@ bool is_gateable(Status s);
 
 constexpr double kNoValue = std::numeric_limits<double>::quiet_NaN();
 
-// One row of a case's summary.csv (one repeat).
+// One of a case's summary rows (one repeat; in its case.txt).
 struct RepeatResult {
   Status status = Status::kFailed;
   std::string reason;
@@ -73,8 +73,8 @@ struct CaseResult {
   // ("energy", "first integrals (a, b)", "" for none).
   double drift = kNoValue;
   std::string drift_name;
-  std::vector<RepeatResult> repeats;  // summary.csv rows, in order
-  // summary.csv as read (header and rows), for the folder's DIR/summary.csv.
+  std::vector<RepeatResult> repeats;  // the summary rows, in order
+  // the summary rows as read (header and rows), for the folder's DIR/summary.csv.
   std::vector<std::string> columns;
   std::vector<std::vector<std::string>> rows;
 
