@@ -167,7 +167,7 @@ struct MatrixRunOptions {
   std::string out_dir;
   int jobs = 1;
   bool force = false;          // rerun even if cached
-  std::string binary_id;       // part of every cache key
+  std::string binary_id;       // part of every cache key; "" or "unknown": nothing reused as cached
   std::string matrix_text;     // stored as DIR/matrix.toml
   size_t selected_cases = 0;   // cases after --filter, before --shard (merge checks coverage)
   std::function<const Problem&(const std::string&)> find_problem;
@@ -187,9 +187,23 @@ struct MatrixRunStats {
 // Runs every case not already complete in out_dir, `jobs` at a time, each in
 // a forked process (a crash or a hang is a recorded result, never the end of
 // the matrix). Writes DIR/cases.csv and DIR/matrix.toml first, then
-// DIR/cases/<id>/{summary.csv, series.csv, key.txt}; key.txt last, so a
-// folder without it is incomplete. Progress goes to `log`: one updating line
-// on a terminal, plain lines otherwise.
+// DIR/cases/<id>/{series.csv.gz, case.txt}; case.txt last (atomically), so
+// a folder without it is incomplete. case.txt, the case's record, is the
+// cache key, a line per result file and the case's summary rows:
+//   problem=wheel                  the case's canonical configuration
+//   ...                            (its hash is the case id)
+//   binary=<size>-<16 hex>         the identity of the cstab binary
+//   file series.csv.gz SIZE HASH   per result file beside it: bytes, 64-bit FNV-1a
+//   for-pictures series.csv.gz     (or `dropped NAME`: shrink_series)
+//   summary SIZE HASH              then SIZE bytes to the end of the file:
+//   case_id,repeat,problem,...     the summary rows (CSV: header, one row
+//   ...                            per repeat), verified like a file
+// A case is reused only if its case.txt is whole, begins with the same
+// configuration and binary, and every file it lists has its recorded size
+// and hash (no unlisted result file beside it); otherwise it runs again and
+// the progress says why. A folder of an older cstab (key.txt and
+// summary.csv) runs again. Progress goes to `log`: one updating line on a
+// terminal, plain lines otherwise.
 //
 // SIGINT, SIGTERM or SIGHUP (while it runs) stop the matrix cleanly: no new
 // case starts, running workers get SIGTERM (SIGKILL after a grace period),
@@ -206,9 +220,9 @@ using SeriesUse = std::map<std::string, std::set<std::string>>;
 
 // After the report, the series of the finished cases in `cases` that do
 // not keep them (keep_series): one no picture reads (not in `used`) is
-// dropped (key.txt no longer lists it and says `dropped series.csv.gz`);
+// dropped (case.txt no longer lists it and says `dropped series.csv.gz`);
 // one a picture reads is cut to the columns it reads, every number at plot
-// precision (csv_select_columns, csv_at_plot_precision; key.txt records the
+// precision (csv_select_columns, csv_at_plot_precision; case.txt records the
 // new file and says `for-pictures series.csv.gz`), from which the report
 // draws the same pictures. Either way the case stays cached unless
 // keep_series later asks for its whole series.

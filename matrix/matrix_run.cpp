@@ -16,6 +16,7 @@
 #include <iostream>
 #include <map>
 #include <memory>
+#include <optional>
 #include <set>
 #include <sstream>
 #include <thread>
@@ -79,10 +80,10 @@ Row failure_row(const MatrixCase& c, Status status, const std::string& reason) {
   return row;
 }
 
-// The files of a case folder whose content key.txt records.
+// The files beside case.txt whose content it records (`file` lines).
 // series.csv.gz is what the worker keeps of the harness's series.csv;
 // series.csv stays listed for folders of older cstab versions.
-constexpr const char* kResultFiles[] = {"summary.csv", "series.csv", "series.csv.gz"};
+constexpr const char* kResultFiles[] = {"series.csv", "series.csv.gz"};
 
 // The harness's series.csv as series.csv.gz (lossless, about 3x smaller):
 // the gzip file is written atomically before the plain one goes.
@@ -108,26 +109,45 @@ std::string content_lines(const std::string& dir) {
   return out;
 }
 
+// The case's record, case.txt: the key, the result files' lines and the
+// summary rows in one file, written last (it marks the result complete).
+// The harness's summary.csv of the first repeat goes first: its row is in
+// `rows`, and a case folder holds no file its record does not account for.
 void write_result(const std::string& dir, const std::vector<Row>& rows, const std::string& key) {
-  write_file_atomic(dir + "/summary.csv", rows_to_csv(rows));
-  // last: marks the result complete, with what it is made of
-  write_file_atomic(dir + "/key.txt", key + content_lines(dir));
+  std::error_code ec;
+  fs::remove(dir + "/summary.csv", ec);
+  if (ec) throw std::runtime_error(dir + "/summary.csv: cannot remove: " + ec.message());
+  write_file_atomic(dir + "/" + kCaseRecordName, case_record_text(key + content_lines(dir), rows_to_csv(rows)));
 }
 
-// Why the cached result in `dir` cannot be reused for `key` ("" if it can):
-// key.txt must hold this configuration and binary, then list every result
-// file with the size and hash it has now. A series dropped or cut by an
-// earlier run (`dropped NAME`, `for-pictures NAME`: shrink_series) is fine
-// unless `need_series`.
-std::string cache_problem(const std::string& dir, const std::string& key, bool need_series) {
+// Why the cached result of `c` in `dir` cannot be reused with this binary
+// ("" if it can): case.txt must be whole (its summary rows of the size and
+// hash it records), begin with this configuration and binary, and list
+// every result file beside it with the size and hash it has now. A series
+// dropped or cut by an earlier run (`dropped NAME`, `for-pictures NAME`:
+// shrink_series) is fine unless `need_series`.
+std::string cache_problem(const std::string& dir, const MatrixCase& c, const std::string& binary_id,
+                          bool need_series) {
+  const std::string key = cache_key(c, binary_id);
   std::string text;
   try {
-    text = read_text_file(dir + "/key.txt");
+    text = read_text_file(dir + "/" + kCaseRecordName);
   } catch (const std::exception&) {
-    return fs::exists(dir) ? "no key.txt (unfinished)" : "not run yet";
+    if (fs::exists(dir + "/key.txt")) return "written by an older cstab (key.txt and summary.csv, no case.txt)";
+    return fs::exists(dir) ? "no case.txt (unfinished)" : "not run yet";
   }
-  if (text.compare(0, key.size(), key) != 0) return "configuration or binary changed";
-  std::istringstream lines(text.substr(key.size()));
+  std::string why;
+  const auto record = parse_case_record(text, why);
+  if (!record) return why;
+  if (record->head.compare(0, key.size(), key) != 0) {
+    // The folder's name is the hash of its configuration: a record of
+    // another configuration was swapped, copied or edited in.
+    if (record->head.compare(0, c.config_text.size(), c.config_text) != 0)
+      return std::string(kCaseRecordName) +
+             " records another configuration (swapped or copied from another case, or edited)";
+    return "configuration or binary changed";
+  }
+  std::istringstream lines(record->head.substr(key.size()));
   std::string line;
   std::set<std::string> listed;
   while (std::getline(lines, line)) {
@@ -141,7 +161,8 @@ std::string cache_problem(const std::string& dir, const std::string& key, bool n
                                 "(keep_series asks for the whole one)";
       continue;
     }
-    if (!(words >> tag >> name >> size >> hash) || tag != "file") return "key.txt: malformed line '" + line + "'";
+    if (!(words >> tag >> name >> size >> hash) || tag != "file")
+      return std::string(kCaseRecordName) + ": malformed line '" + line + "'";
     listed.insert(name);
     const std::string path = dir + "/" + name;
     std::error_code ec;
@@ -157,9 +178,9 @@ std::string cache_problem(const std::string& dir, const std::string& key, bool n
     }
     if (hash_hex(bytes) != hash) return name + " content differs from the recorded hash (edited or swapped)";
   }
-  if (!listed.count("summary.csv")) return "key.txt records no content hashes (written by an older cstab)";
-  for (const char* name : kResultFiles)
-    if (!listed.count(name) && fs::exists(dir + "/" + name)) return std::string(name) + " not recorded in key.txt";
+  for (const char* name : {"series.csv", "series.csv.gz", "summary.csv"})
+    if (!listed.count(name) && fs::exists(dir + "/" + name))
+      return std::string(name) + " not recorded in " + kCaseRecordName;
   return "";
 }
 
@@ -303,7 +324,7 @@ std::vector<const MatrixCase*> uncached_cases(const std::vector<MatrixCase>& cas
   for (const auto& c : cases) {
     const std::string dir = case_folder(opt.out_dir, c.entry.id);
     if (!opt.force && !opt.binary_id.empty() && opt.binary_id != "unknown") {
-      const std::string why = cache_problem(dir, cache_key(c, opt.binary_id), c.keep_series && c.config.write_series);
+      const std::string why = cache_problem(dir, c, opt.binary_id, c.keep_series && c.config.write_series);
       if (why.empty()) {
         ++stats.cached;
         continue;
@@ -431,7 +452,7 @@ void WorkerPool::draw(bool force) {
 void WorkerPool::start_worker(const MatrixCase& c) {
   std::error_code ec;
   const std::string dir = case_folder(opt_.out_dir, c.entry.id);
-  fs::remove_all(dir, ec);  // nothing stale survives: incomplete until the worker writes key.txt
+  fs::remove_all(dir, ec);  // nothing stale survives: incomplete until the worker writes case.txt
   fs::create_directories(dir, ec);
   const std::string key = cache_key(c, opt_.binary_id);
   const Problem& problem = opt_.find_problem(c.config.problem);
@@ -592,7 +613,7 @@ void WorkerPool::report_line(const MatrixCase& c, Status outcome, const std::str
 
 // Stop: nothing new starts; running workers get SIGTERM, SIGKILL after
 // a grace period. One that still exits on its own has finished (its
-// key.txt is written) and is recorded; the others leave no folder.
+// case.txt is written) and is recorded; the others leave no folder.
 void WorkerPool::stop() {
   stats_.interrupted_by = g_stop_signal;
   if (tty_) log_ << "\r\033[K";
@@ -807,7 +828,8 @@ void read_shard(Shards& shards, const std::string& out_dir, const std::vector<st
   }
 }
 
-// Copies every complete case folder not already in out_dir (key.txt last); returns how many.
+// Copies every complete case folder not already in out_dir (case.txt
+// last, into a folder emptied first); returns how many.
 size_t copy_complete_cases(const std::string& out_dir, const Shards& shards, std::vector<CaseEntry>& entries) {
   std::error_code ec;
   size_t copied = 0;
@@ -816,15 +838,15 @@ size_t copy_complete_cases(const std::string& out_dir, const Shards& shards, std
     entries.push_back(e);
     if (!load_case_result(source, e).complete) continue;  // counted by write_matrix_summary
     const std::string from = case_folder(source, e.id), to = case_folder(out_dir, e.id);
-    const std::string key = read_text_file(from + "/key.txt");
-    if (file_equals(to + "/key.txt", key)) continue;
+    const std::string record = read_text_file(from + "/" + kCaseRecordName);
+    if (file_equals(to + "/" + kCaseRecordName, record)) continue;
+    fs::remove_all(to, ec);
     fs::create_directories(to, ec);
-    fs::remove(to + "/key.txt", ec);
     for (const auto& f : fs::directory_iterator(from)) {
-      if (f.path().filename() == "key.txt" || !f.is_regular_file()) continue;
+      if (f.path().filename() == kCaseRecordName || !f.is_regular_file()) continue;
       fs::copy_file(f.path(), to + "/" + f.path().filename().string(), fs::copy_options::overwrite_existing);
     }
-    write_file_atomic(to + "/key.txt", key);
+    write_file_atomic(to + "/" + kCaseRecordName, record);
     ++copied;
   }
   return copied;
@@ -872,45 +894,56 @@ size_t merge_results(const std::string& out_dir, const std::vector<std::string>&
 
 namespace {
 
-// key.txt of `dir` with its `file NAME ...` line replaced by `lines`; ""
-// if key.txt is unreadable (unfinished: the next run redoes the case) or
-// does not record NAME (left for the cache check to refuse).
-std::string key_with(const std::string& dir, const std::string& name, const std::string& lines) {
-  std::string key;
+// The record (case.txt) of `dir`, split at its `summary` line; nullopt if
+// it is unreadable or not whole (unfinished or damaged: the cache check
+// deals with it).
+std::optional<CaseRecord> read_record(const std::string& dir) {
   try {
-    key = read_text_file(dir + "/key.txt");
+    std::string why;
+    return parse_case_record(read_text_file(dir + "/" + kCaseRecordName), why);
   } catch (const std::exception&) {
-    return "";
+    return std::nullopt;
   }
-  const size_t at = key.find("\nfile " + name + " ");
-  if (at == std::string::npos) return "";
-  const size_t end = key.find('\n', at + 1);
-  key.erase(at + 1, end == std::string::npos ? std::string::npos : end - at);
-  return key + lines;
 }
 
-// Drops a series: key.txt first (without the file's line, with `dropped
-// NAME`), then the file; a crash between the two leaves a file key.txt does
-// not record, which cache_problem refuses, so the case runs again.
+// The text of the record of `dir` with its `file NAME ...` line replaced
+// by `lines`; "" if the record is unreadable or not whole (the next run
+// redoes the case) or does not record NAME (left for the cache check to
+// refuse).
+std::string record_with(const std::string& dir, const std::string& name, const std::string& lines) {
+  auto record = read_record(dir);
+  if (!record) return "";
+  std::string& head = record->head;
+  const size_t at = head.find("\nfile " + name + " ");
+  if (at == std::string::npos) return "";
+  const size_t end = head.find('\n', at + 1);
+  head.erase(at + 1, end == std::string::npos ? std::string::npos : end - at);
+  return case_record_text(head + lines, record->summary);
+}
+
+// Drops a series: case.txt first (without the file's line, with `dropped
+// NAME`), then the file; a crash between the two leaves a file case.txt
+// does not record, which cache_problem refuses, so the case runs again.
 bool drop_series_file(const std::string& dir, const std::string& name) {
-  const std::string key = key_with(dir, name, "dropped " + name + "\n");
-  if (key.empty()) return false;
-  write_file_atomic(dir + "/key.txt", key);
+  const std::string record = record_with(dir, name, "dropped " + name + "\n");
+  if (record.empty()) return false;
+  write_file_atomic(dir + "/" + kCaseRecordName, record);
   std::error_code ec;
   fs::remove(dir + "/" + name, ec);
   return true;
 }
 
 // Cuts series.csv.gz to the `columns` the pictures read, at plot precision:
-// the file first, then key.txt with its new size and hash and
+// the file first, then case.txt with its new size and hash and
 // `for-pictures NAME`; a crash between the two leaves a file whose hash
-// key.txt does not match, so the case runs again. Returns the bytes saved;
+// case.txt does not match, so the case runs again. Returns the bytes saved;
 // 0 if it was cut before.
 unsigned long long cut_series_file(const std::string& dir, const std::set<std::string>& columns) {
   const std::string name = "series.csv.gz", path = dir + "/" + name;
+  const auto record = read_record(dir);
+  if (!record || record->head.find("\nfor-pictures " + name + "\n") != std::string::npos) return 0;
   std::string whole;
   try {
-    if (read_text_file(dir + "/key.txt").find("\nfor-pictures " + name + "\n") != std::string::npos) return 0;
     whole = read_text_file(path);
   } catch (const std::exception&) {
     return 0;  // unfinished or missing: the cache check deals with it
@@ -918,10 +951,10 @@ unsigned long long cut_series_file(const std::string& dir, const std::set<std::s
   const std::string csv = gzip_decompress(whole, kMaxInputFileBytes);
   const std::string cut = gzip_compress(csv_at_plot_precision(csv_select_columns(csv, columns)));
   const std::string line = "file " + name + " " + std::to_string(cut.size()) + " " + hash_hex(cut) + "\n";
-  const std::string key = key_with(dir, name, line + "for-pictures " + name + "\n");
-  if (key.empty() || cut.size() >= whole.size()) return 0;
+  const std::string text = record_with(dir, name, line + "for-pictures " + name + "\n");
+  if (text.empty() || cut.size() >= whole.size()) return 0;
   write_file_atomic(path, cut);
-  write_file_atomic(dir + "/key.txt", key);
+  write_file_atomic(dir + "/" + kCaseRecordName, text);
   return whole.size() - cut.size();
 }
 

@@ -67,16 +67,17 @@ std::string command_output(const std::string& command) {
   return out;
 }
 
+std::string binary_identity_of(const std::string& path) {
+  try {
+    const std::string bytes = read_text_file(path);
+    return std::to_string(bytes.size()) + "-" + hash_hex(bytes);
+  } catch (const std::exception&) {
+    return "unknown";
+  }
+}
+
 const std::string& binary_identity() {
-  static const std::string id = [] {
-    const std::string path = self_path();
-    try {
-      const std::string bytes = read_text_file(path);
-      return std::to_string(bytes.size()) + "-" + hash_hex(bytes);
-    } catch (const std::exception&) {
-      return std::string("unknown");
-    }
-  }();
+  static const std::string id = binary_identity_of(self_path());
   return id;
 }
 

@@ -13,7 +13,12 @@ using Provenance = std::vector<std::pair<std::string, std::string>>;
 
 // Identity of the running executable: its size and a hash of its bytes.
 // Part of every case's cache key: a rebuilt binary reruns the matrix.
+// "unknown" if it cannot be read (execute-only, deleted or replaced while
+// starting); then the matrix reuses no cached result (MatrixRunOptions).
 const std::string& binary_identity();
+// The identity of the executable at `path` ("<size>-<hash>"), "unknown"
+// if it cannot be read: binary_identity() of /proc/self/exe's target.
+std::string binary_identity_of(const std::string& path);
 
 // Date, host, OS, CPU, git revision of the source tree, compiler and flags,
 // library versions (Eigen, GSL, SUNDIALS, gnuplot), binary path and identity.

@@ -4,9 +4,11 @@
 #include <cmath>
 #include <filesystem>
 #include <map>
+#include <sstream>
 
 #include "core/format.hpp"
 #include "io/gzip.hpp"
+#include "io/hash.hpp"
 #include "io/number.hpp"
 
 namespace cstab {
@@ -166,14 +168,48 @@ double median(std::vector<double> v) {
   return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
 }
 
+std::string case_record_text(const std::string& head, const std::string& summary) {
+  return head + "summary " + std::to_string(summary.size()) + " " + hash_hex(summary) + "\n" + summary;
+}
+
+std::optional<CaseRecord> parse_case_record(const std::string& text, std::string& why) {
+  size_t at = text.compare(0, 8, "summary ") == 0 ? 0 : text.find("\nsummary ");
+  if (at == std::string::npos) {
+    why = std::string(kCaseRecordName) + " has no summary line (truncated)";
+    return std::nullopt;
+  }
+  if (at > 0) ++at;
+  const size_t end = text.find('\n', at);
+  std::istringstream words(text.substr(at, end == std::string::npos ? std::string::npos : end - at));
+  std::string tag, hash, extra;
+  unsigned long long size = 0;
+  if (end == std::string::npos || !(words >> tag >> size >> hash) || (words >> extra)) {
+    why = std::string(kCaseRecordName) + ": malformed summary line (truncated or edited)";
+    return std::nullopt;
+  }
+  CaseRecord record{text.substr(0, at), text.substr(end + 1)};
+  if (record.summary.size() != size) {
+    why = std::string(kCaseRecordName) + ": its summary rows have " + std::to_string(record.summary.size()) +
+          " bytes, " + std::to_string(size) + " recorded (truncated or edited)";
+    return std::nullopt;
+  }
+  if (hash_hex(record.summary) != hash) {
+    why = std::string(kCaseRecordName) + ": its summary rows differ from the recorded hash (edited)";
+    return std::nullopt;
+  }
+  return record;
+}
+
 CaseResult load_case_result(const std::string& dir, const CaseEntry& entry) {
   CaseResult c;
   c.entry = &entry;
-  const std::string folder = dir + "/cases/" + entry.id;
-  if (!fs::exists(folder + "/key.txt")) return c;
+  const std::string path = dir + "/cases/" + entry.id + "/" + kCaseRecordName;
   CsvTable t;
   try {
-    t = read_csv(folder + "/summary.csv");
+    std::string why;
+    const auto record = parse_case_record(read_text_file(path), why);
+    if (!record) return c;
+    t = parse_csv(record->summary, path);
   } catch (const std::exception&) {
     return c;
   }

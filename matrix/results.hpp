@@ -2,7 +2,7 @@
 // folder", results/README.md) says about each case, parsed once. `cstab
 // report`, the stress section, `cstab gate`, summary and merge all read a
 // folder through load_results_folder; nothing else parses a case's
-// summary.csv or compares status text.
+// summary rows (in its case.txt) or compares status text.
 #pragma once
 
 #include <limits>
@@ -38,7 +38,7 @@ bool is_gateable(Status s);
 
 constexpr double kNoValue = std::numeric_limits<double>::quiet_NaN();
 
-// One row of a case's summary.csv (one repeat).
+// One of a case's summary rows (one repeat; in its case.txt).
 struct RepeatResult {
   Status status = Status::kFailed;
   std::string reason;
@@ -51,7 +51,7 @@ struct RepeatResult {
 // same values.
 struct CaseResult {
   const CaseEntry* entry = nullptr;
-  bool complete = false;             // key.txt and a readable summary.csv with a row
+  bool complete = false;             // a whole case.txt whose summary rows hold a row
   Status status = Status::kNotRun;   // the first repeat that is not ok, else ok
   std::string reason;                // of that repeat
   std::string formulation;           // as resolved by the run (summary.csv)
@@ -73,8 +73,8 @@ struct CaseResult {
   // ("energy", "first integrals (a, b)", "" for none).
   double drift = kNoValue;
   std::string drift_name;
-  std::vector<RepeatResult> repeats;  // summary.csv rows, in order
-  // summary.csv as read (header and rows), for the folder's DIR/summary.csv.
+  std::vector<RepeatResult> repeats;  // the summary rows, in order
+  // the summary rows as read (header and rows), for the folder's DIR/summary.csv.
   std::vector<std::string> columns;
   std::vector<std::vector<std::string>> rows;
 
@@ -105,11 +105,30 @@ struct ResultsFolder {
   ResultsFolder(ResultsFolder&&) = default;
 };
 
-// Reads DIR/cases.csv and every case folder's summary.csv (complete only if
-// key.txt is there). Throws UsageError if DIR is not a results folder.
+// Reads DIR/cases.csv and every case folder's record, cases/<id>/case.txt
+// (complete only if it is whole: its summary rows have the size and hash it
+// records). Throws UsageError if DIR is not a results folder.
 ResultsFolder load_results_folder(const std::string& dir);
 // The result of one case of `dir` (complete or not).
 CaseResult load_case_result(const std::string& dir, const CaseEntry& entry);
+
+// The record of a finished case, cases/<id>/case.txt (format: matrix.hpp,
+// above run_matrix): a head (the cache key and the result files' lines),
+// then a line `summary SIZE HASH` and the case's summary rows, SIZE bytes of
+// CSV to the end of the file. Written atomically and last: it marks the
+// case complete.
+inline constexpr const char* kCaseRecordName = "case.txt";
+struct CaseRecord {
+  std::string head;     // every line before the `summary` line
+  std::string summary;  // the summary rows (CSV text: header, one row per repeat)
+};
+// The text of a record: `head` (empty or ending in a newline), the
+// `summary SIZE HASH` line of `summary`, then `summary`.
+std::string case_record_text(const std::string& head, const std::string& summary);
+// Splits a record's text at its first `summary` line. nullopt, with the
+// reason in `why`, if there is none or the rows after it do not have the
+// size and hash it records (a truncated or edited record).
+std::optional<CaseRecord> parse_case_record(const std::string& text, std::string& why);
 
 // cases/<id>/series.csv.gz (or series.csv) of a case; empty (no header, no rows) if it is
 // missing or unreadable.

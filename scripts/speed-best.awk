@@ -1,6 +1,7 @@
-# Reads case summary.csv files (one row per repeat; the header of each file
-# names its columns) and prints, per problem x method (x formulation), the
-# case with the smallest median wall time whose reference error is <= TARGET:
+# Reads summary.csv files (a matrix folder's DIR/summary.csv: one row per
+# repeat of every case; the header of each file names its columns) and
+# prints, per problem x method (x formulation), the case with the smallest
+# median wall time whose reference error is <= TARGET:
 #   problem,method,formulation,integrator,setting,params,median_wall,repeats,ref_error,steps,rhs_evals,case_id,newton_per_step
 # Fields are split on commas: no value of the columns used contains one.
 BEGIN { FS = ","; if (TARGET == "") TARGET = 1e-8 }

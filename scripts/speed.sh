@@ -25,10 +25,9 @@ mkdir -p "$OUT"
 
 echo "speed: stage 1 (sweep) into $SWEEP" >&2
 "$CSTAB" matrix matrices/speed.toml --out "$SWEEP" --jobs "$JOBS" --no-report >"$OUT/sweep.log"
-# Only the cases of this matrix (the folder may hold cases of earlier versions of it).
-ids=$(awk -F, 'NR == 1 { for (i = 1; i <= NF; i++) if ($i == "case_id") c = i; next } { print $c }' "$SWEEP/cases.csv")
-files=(); for id in $ids; do [[ -f "$SWEEP/cases/$id/summary.csv" ]] && files+=("$SWEEP/cases/$id/summary.csv"); done
-awk -v TARGET="$TARGET" -f scripts/speed-best.awk "${files[@]}" | sort >"$OUT/stage1-best.csv"
+# The folder's summary.csv: every repeat of the cases of this matrix only
+# (the folder may hold cases of earlier versions of it).
+awk -v TARGET="$TARGET" -f scripts/speed-best.awk "$SWEEP/summary.csv" | sort >"$OUT/stage1-best.csv"
 
 # Stage 2: one sweep per chosen case, all its parameters spelled out.
 awk -F, -v R="$REPEATS" '
@@ -42,7 +41,7 @@ awk -F, -v R="$REPEATS" '
 echo "speed: stage 2 (re-timing $(wc -l <"$OUT/stage1-best.csv") cases, $REPEATS repeats, one at a time)" >&2
 rm -rf "$OUT/retime"
 "$CSTAB" matrix "$OUT/retime.toml" --out "$OUT/retime" --jobs 1 --no-report >"$OUT/retime.log"
-awk -v TARGET="$TARGET" -f scripts/speed-best.awk "$OUT"/retime/cases/*/summary.csv | sort >"$OUT/stage2-best.csv"
+awk -v TARGET="$TARGET" -f scripts/speed-best.awk "$OUT/retime/summary.csv" | sort >"$OUT/stage2-best.csv"
 
 # Ratios within the stage-2 run: to IDA-GGL, to the minimal-coordinate ODE
 # and to the fastest method of the problem (the minimal ODE left out).

@@ -331,7 +331,7 @@ size_t finished_cases(const fs::path& out) {
   size_t n = 0;
   std::error_code ec;
   for (const auto& e : fs::directory_iterator(out / "cases", ec))
-    if (fs::exists(e.path() / "key.txt")) ++n;
+    if (fs::exists(e.path() / "case.txt")) ++n;
   return n;
 }
 
@@ -415,14 +415,14 @@ class MatrixInterrupt : public ::testing::Test {
     for (const auto& e : fs::recursive_directory_iterator(out)) {
       EXPECT_EQ(e.path().filename().string().find(".tmp."), std::string::npos) << e.path();
       if (e.is_directory() && e.path().parent_path().filename() == "cases") {
-        EXPECT_TRUE(fs::exists(e.path() / "key.txt")) << "unfinished case folder left: " << e.path();
+        EXPECT_TRUE(fs::exists(e.path() / "case.txt")) << "unfinished case folder left: " << e.path();
       }
     }
     // The summary of what finished: one row per finished case.
     const CsvTable partial = read_csv((out / "summary.csv").string());
     EXPECT_EQ(partial.rows.size(), kept);
     for (size_t r = 0; r < partial.rows.size(); ++r) {
-      EXPECT_TRUE(fs::exists(out / "cases" / partial.get(r, "case_id") / "key.txt"));
+      EXPECT_TRUE(fs::exists(out / "cases" / partial.get(r, "case_id") / "case.txt"));
       EXPECT_NE(partial.get(r, "status"), "crashed") << "an interrupted worker recorded as a crash";
     }
     // Resume.

@@ -134,12 +134,12 @@ bool rows_are_a_subset(const fs::path& partial, const fs::path& full) {
   return true;
 }
 
-// Every case folder below `out`/cases that has no key.txt (half-written).
+// Every case folder below `out`/cases that has no case.txt (half-written).
 std::vector<std::string> unfinished_case_folders(const fs::path& out) {
   std::vector<std::string> found;
   std::error_code ec;
   for (const auto& e : fs::directory_iterator(out / "cases", ec))
-    if (e.is_directory() && !fs::exists(e.path() / "key.txt")) found.push_back(e.path().filename().string());
+    if (e.is_directory() && !fs::exists(e.path() / "case.txt")) found.push_back(e.path().filename().string());
   return found;
 }
 
@@ -414,13 +414,21 @@ TEST_F(CrashConsistency, DamagedCachedFilesAreRerunToTheSameSummary) {
   const cstab::CsvTable cases = cstab::read_csv((out / "cases.csv").string());
   ASSERT_GE(cases.rows.size(), 6u);
   auto folder = [&](size_t i) { return out / "cases" / cases.get(i, "case_id"); };
-  fs::resize_file(folder(0) / "series.csv.gz", 100);                             // truncated
-  std::ofstream(folder(1) / "summary.csv", std::ios::app) << "\n";            // edited
-  fs::remove(folder(2) / "series.csv.gz");                                      // deleted
-  fs::remove(folder(3) / "summary.csv");                                     // deleted
-  fs::rename(folder(4) / "series.csv.gz", dir_->dir() / "s4.csv");              // swapped
-  fs::copy_file(folder(5) / "series.csv.gz", folder(4) / "series.csv.gz");
-  fs::rename(dir_->dir() / "s4.csv", folder(5) / "series.csv.gz");
+  // Each case's record (case.txt: key, series hash, summary rows) damaged
+  // one way, or its series.
+  fs::resize_file(folder(0) / "case.txt", fs::file_size(folder(0) / "case.txt") - 3);  // truncated
+  {  // a number of the summary rows edited, the size kept
+    std::string record = slurp(folder(1) / "case.txt");
+    const size_t at = record.rfind("e-") - 1;
+    ASSERT_GT(at, record.find("\nsummary ")) << record;
+    record[at] = record[at] == '1' ? '2' : '1';
+    std::ofstream(folder(1) / "case.txt", std::ios::binary) << record;
+  }
+  fs::resize_file(folder(2) / "series.csv.gz", 100);                             // series truncated
+  fs::remove(folder(3) / "case.txt");                                           // deleted
+  fs::rename(folder(4) / "case.txt", dir_->dir() / "c4.txt");                   // swapped
+  fs::rename(folder(5) / "case.txt", folder(4) / "case.txt");
+  fs::rename(dir_->dir() / "c4.txt", folder(5) / "case.txt");
   fs::remove(out / "summary.csv");
   const pid_t pid = spawn_matrix(toml(), out, out.string() + ".log");
   ASSERT_EQ(wait_code(pid), 0) << slurp(out.string() + ".log");
@@ -428,8 +436,19 @@ TEST_F(CrashConsistency, DamagedCachedFilesAreRerunToTheSameSummary) {
   size_t reruns = 0;
   for (size_t p = log.find("matrix: rerun "); p != std::string::npos; p = log.find("matrix: rerun ", p + 1)) ++reruns;
   EXPECT_EQ(reruns, 6u) << log;
+  // Each rerun says why.
+  const std::pair<size_t, const char*> why[] = {
+      {0, "case.txt: its summary rows have "},
+      {1, "case.txt: its summary rows differ from the recorded hash (edited)"},
+      {2, "series.csv.gz has 100 bytes"},
+      {3, "no case.txt (unfinished)"},
+      {4, "case.txt records another configuration (swapped or copied from another case, or edited)"},
+      {5, "case.txt records another configuration (swapped or copied from another case, or edited)"}};
+  for (const auto& [i, reason] : why)
+    EXPECT_NE(log.find("(" + cases.get(i, "case_id") + "): " + reason), std::string::npos) << i << ": " << log;
   EXPECT_NE(log.find("6 run, 0 cached"), std::string::npos) << log;
   EXPECT_EQ(summary_without_timing(out / "summary.csv"), expected());
+  EXPECT_EQ(unfinished_case_folders(out), std::vector<std::string>{});
 }
 
 

@@ -143,12 +143,13 @@ TEST(GateThresholds, StatusNamesRoundTrip) {
 
 // The loader the gate and the report share, on a hand-written folder: a
 // case whose second repeat diverged is diverged (with that repeat's
-// reason), its median is over the ok repeats only; a case without key.txt
-// is not run; "1e-3" in summary.csv reads as 0.001.
+// reason), its median is over the ok repeats only; a case without a whole
+// case.txt (a folder of an older cstab, a record edited after it was
+// written) is not run; "1e-3" in the summary rows reads as 0.001.
 TEST(GateThresholds, ResultsModelFoldsRepeats) {
   Scratch s("cstab_model");
   const std::string dir = (s.dir() / "r").string();
-  std::vector<cstab::CaseEntry> entries(3);
+  std::vector<cstab::CaseEntry> entries(4);
   for (size_t i = 0; i < entries.size(); ++i) {
     entries[i].index = i;
     entries[i].id = "000000000000000" + std::to_string(i);
@@ -163,17 +164,25 @@ TEST(GateThresholds, ResultsModelFoldsRepeats) {
   }
   cstab::write_manifest(dir + "/cases.csv", entries, entries.size());
   const std::string head = "case_id,repeat,status,reason,step,wall_seconds,max_residual,energy_law,max_energy_drift\n";
-  write(dir + "/cases/0000000000000000/summary.csv",
-        head + "0000000000000000,0,ok,,1e-3,0.5,1e-9,yes,1e-6\n0000000000000000,1,ok,,1e-3,0.25,2e-9,yes,1e-6\n"
-               "0000000000000000,2,diverged,residual above 1e3,1e-3,0.1,5e3,yes,\n");
-  write(dir + "/cases/0000000000000000/key.txt", "k\n");
-  write(dir + "/cases/0000000000000001/summary.csv",
-        "case_id,repeat,status,reason,t_end\n0000000000000001,0,timeout,killed after 1 s (timeout),1\n");
-  write(dir + "/cases/0000000000000001/key.txt", "k\n");
+  const auto record = [&](const std::string& id, const std::string& rows) {
+    write(dir + "/cases/" + id + "/case.txt", cstab::case_record_text("k\n", rows));
+  };
+  record("0000000000000000",
+         head + "0000000000000000,0,ok,,1e-3,0.5,1e-9,yes,1e-6\n0000000000000000,1,ok,,1e-3,0.25,2e-9,yes,1e-6\n"
+                "0000000000000000,2,diverged,residual above 1e3,1e-3,0.1,5e3,yes,\n");
+  record("0000000000000001",
+         "case_id,repeat,status,reason,t_end\n0000000000000001,0,timeout,killed after 1 s (timeout),1\n");
+  // As an older cstab wrote it: incomplete.
   write(dir + "/cases/0000000000000002/summary.csv", head + "0000000000000002,0,ok,,1e-3,0.5,1e-9,yes,1e-6\n");
-  // no key.txt: incomplete
+  write(dir + "/cases/0000000000000002/key.txt", "k\n");
+  // A number edited after the record was written: incomplete.
+  {
+    std::string text = cstab::case_record_text("k\n", head + "0000000000000003,0,ok,,1e-3,0.5,1e-9,yes,1e-6\n");
+    text.replace(text.find("1e-9"), 4, "1e-8");  // same size: the hash tells
+    write(dir + "/cases/0000000000000003/case.txt", text);
+  }
   const cstab::ResultsFolder f = cstab::load_results_folder(dir);
-  ASSERT_EQ(f.cases.size(), 3u);
+  ASSERT_EQ(f.cases.size(), 4u);
   const cstab::CaseResult& a = f.cases[0];
   EXPECT_TRUE(a.complete);
   EXPECT_EQ(a.status, cstab::Status::kDiverged);
@@ -192,11 +201,13 @@ TEST(GateThresholds, ResultsModelFoldsRepeats) {
   EXPECT_EQ(b.status, cstab::Status::kTimeout);
   EXPECT_TRUE(std::isnan(b.wall_median));
   EXPECT_TRUE(std::isnan(b.max_residual));
-  const cstab::CaseResult& c = f.cases[2];
-  EXPECT_FALSE(c.complete);
-  EXPECT_EQ(c.status, cstab::Status::kNotRun);
+  for (size_t i : {2, 3}) {
+    const cstab::CaseResult& c = f.cases[i];
+    EXPECT_FALSE(c.complete) << i;
+    EXPECT_EQ(c.status, cstab::Status::kNotRun) << i;
+  }
   // DIR/summary.csv: the complete cases' rows as written, the sweep after "repeat".
-  EXPECT_EQ(cstab::write_matrix_summary(dir, f.entries), 1u);
+  EXPECT_EQ(cstab::write_matrix_summary(dir, f.entries), 2u);
   const cstab::CsvTable t = cstab::read_csv(dir + "/summary.csv");
   ASSERT_EQ(t.rows.size(), 4u);
   EXPECT_EQ(t.header[2], "sweep");

@@ -1,6 +1,6 @@
 // The matrix keeps each case's series as series.csv.gz: gzip round-trips the
 // harness's bytes exactly, the same bytes always compress the same way (the
-// content hash in key.txt is stable), a damaged file is refused, and the
+// content hash in case.txt is stable), a damaged file is refused, and the
 // results loader (which the report and the stress report read series
 // through) gives the same table from series.csv.gz as from series.csv.
 #include <gtest/gtest.h>

@@ -6,8 +6,10 @@
 // numbers that are not decimal); a results folder is locked while a command
 // writes it (a refused command leaves no new lock file; merge refuses a
 // shard a matrix is writing); a cached case is
-// re-verified against the content hashes in its key.txt and rerun, saying
-// why, when a file is missing, truncated, edited or swapped.
+// re-verified against the content hashes in its case.txt and rerun, saying
+// why, when a file or the record itself is missing, truncated, edited or
+// swapped, or was written by an older cstab; a binary that cannot be read
+// has the identity "unknown" and nothing is reused as cached.
 #include <gtest/gtest.h>
 #include <signal.h>
 #include <sys/wait.h>
@@ -19,6 +21,7 @@
 #include <filesystem>
 #include <fstream>
 #include <set>
+#include <sstream>
 #include <string>
 #include <thread>
 #include <vector>
@@ -26,9 +29,12 @@
 #include "core/params.hpp"
 #include "io/csv.hpp"
 #include "io/gzip.hpp"
+#include "io/hash.hpp"
 #include "io/lock.hpp"
 #include "io/number.hpp"
 #include "matrix/matrix.hpp"
+#include "matrix/provenance.hpp"
+#include "matrix/results.hpp"
 #include "methods/pair.hpp"
 #include "problems/registry.hpp"
 #include "tests/support/test_util.hpp"
@@ -474,28 +480,50 @@ TEST_F(Folder, ACachedCaseWhoseFilesChangedIsRerunSayingWhy) {
   Outcome o = cstab_cmd(matrix_into(dir));
   ASSERT_EQ(o.code, 0) << o.out;
   EXPECT_TRUE(contains(o.out, "4 of 4 cases cached")) << o.out;
-  // Truncated series, edited summary, deleted series, swapped summaries.
+  // Truncated series, an edited number in a record's summary rows, a
+  // deleted series, a record copied over another case's.
   const fs::path c0 = dir / "cases" / id[0], c1 = dir / "cases" / id[1], c2 = dir / "cases" / id[2],
                  c3 = dir / "cases" / id[3];
   fs::resize_file(c0 / "series.csv.gz", fs::file_size(c0 / "series.csv.gz") / 2);
-  std::string summary = slurp(c1 / "summary.csv");
-  summary[summary.size() - 2] = summary[summary.size() - 2] == '1' ? '2' : '1';
-  std::ofstream(c1 / "summary.csv", std::ios::binary) << summary;
+  std::string record = slurp(c1 / "case.txt");
+  record[record.size() - 2] = record[record.size() - 2] == '1' ? '2' : '1';
+  std::ofstream(c1 / "case.txt", std::ios::binary) << record;
   fs::remove(c2 / "series.csv.gz");
-  fs::rename(c3 / "summary.csv", dir / "tmp.csv");
-  fs::copy_file(c2 / "summary.csv", c3 / "summary.csv");
+  fs::copy_file(c2 / "case.txt", c3 / "case.txt", fs::copy_options::overwrite_existing);
   o = cstab_cmd(matrix_into(dir));
   ASSERT_EQ(o.code, 0) << o.out;
   EXPECT_TRUE(contains(o.out, "rerun ")) << o.out;
   EXPECT_TRUE(contains(o.out, "(" + id[0] + "): series.csv.gz has ")) << o.out;
-  EXPECT_TRUE(contains(o.out, "(" + id[1] + "): summary.csv content differs from the recorded hash")) << o.out;
+  EXPECT_TRUE(contains(o.out, "(" + id[1] + "): case.txt: its summary rows differ from the recorded hash (edited)"))
+      << o.out;
   EXPECT_TRUE(contains(o.out, "(" + id[2] + "): series.csv.gz missing")) << o.out;
-  EXPECT_TRUE(contains(o.out, "(" + id[3] + "): summary.csv")) << o.out;
+  EXPECT_TRUE(contains(o.out, "(" + id[3] + "): case.txt records another configuration (swapped or copied")) << o.out;
   EXPECT_TRUE(contains(o.out, "4 run, 0 cached")) << o.out;
   EXPECT_EQ(cstab::testing::summary_without_timing(dir / "summary.csv"), full);
   // And now all of it verifies again.
   o = cstab_cmd(matrix_into(dir));
   EXPECT_TRUE(contains(o.out, "4 of 4 cases cached")) << o.out;
+  // A truncated record, a stray summary.csv beside a record, a deleted
+  // record, and a folder as an older cstab wrote it (key.txt and
+  // summary.csv, no case.txt).
+  fs::resize_file(c0 / "case.txt", fs::file_size(c0 / "case.txt") - 10);
+  std::ofstream(c1 / "summary.csv") << "case_id,repeat\n" << id[1] << ",0\n";
+  fs::remove(c2 / "case.txt");
+  fs::rename(c3 / "case.txt", c3 / "key.txt");
+  std::ofstream(c3 / "summary.csv") << "case_id,repeat\n" << id[3] << ",0\n";
+  o = cstab_cmd(matrix_into(dir));
+  ASSERT_EQ(o.code, 0) << o.out;
+  EXPECT_TRUE(contains(o.out, "(" + id[0] + "): case.txt: its summary rows have ")) << o.out;
+  EXPECT_TRUE(contains(o.out, "(" + id[1] + "): summary.csv not recorded in case.txt")) << o.out;
+  EXPECT_TRUE(contains(o.out, "(" + id[2] + "): no case.txt (unfinished)")) << o.out;
+  EXPECT_TRUE(contains(o.out, "(" + id[3] + "): written by an older cstab")) << o.out;
+  EXPECT_TRUE(contains(o.out, "4 run, 0 cached")) << o.out;
+  EXPECT_EQ(cstab::testing::summary_without_timing(dir / "summary.csv"), full);
+  for (const auto& i : id) {  // a case folder: its record and its series, nothing else
+    std::set<std::string> names;
+    for (const auto& e : fs::directory_iterator(dir / "cases" / i)) names.insert(e.path().filename().string());
+    EXPECT_EQ(names, (std::set<std::string>{"case.txt", "series.csv.gz"})) << i;
+  }
 }
 
 // ------------------------------------------------------------- series the pictures read
@@ -527,12 +555,12 @@ TEST_F(Folder, TheMatrixKeepsOnlyWhatThePicturesReadAndKeepSeriesBringsTheWholeS
   EXPECT_EQ(series_files(dir), 1u);
   size_t dropped = 0;
   for (const auto& i : id) {
-    const std::string key = slurp(dir / "cases" / i / "key.txt");
+    const std::string record = slurp(dir / "cases" / i / "case.txt");
     const fs::path series = dir / "cases" / i / "series.csv.gz";
     const bool has = fs::exists(series);
-    EXPECT_EQ(contains(key, "\nfile series.csv.gz "), has) << key;
-    EXPECT_EQ(contains(key, "\ndropped series.csv.gz\n"), !has) << key;
-    EXPECT_EQ(contains(key, "\nfor-pictures series.csv.gz\n"), has) << key;
+    EXPECT_EQ(contains(record, "\nfile series.csv.gz "), has) << record;
+    EXPECT_EQ(contains(record, "\ndropped series.csv.gz\n"), !has) << record;
+    EXPECT_EQ(contains(record, "\nfor-pictures series.csv.gz\n"), has) << record;
     dropped += !has;
     if (!has) continue;
     // The kept one: t, the positions the trajectories show, the residuals
@@ -579,13 +607,107 @@ TEST_F(Folder, TheMatrixKeepsOnlyWhatThePicturesReadAndKeepSeriesBringsTheWholeS
   EXPECT_EQ(cstab::testing::summary_without_timing(dir / "summary.csv"), full);
 }
 
-TEST_F(Folder, KeyFilesRecordTheContentOfTheResult) {
-  const std::string key = slurp(shard() / "cases" / ids()[0] / "key.txt");
-  EXPECT_TRUE(contains(key, "\nfile summary.csv ")) << key;
-  EXPECT_TRUE(contains(key, "\nfile series.csv.gz ")) << key;
-  // The matrix keeps the series compressed only.
-  EXPECT_FALSE(fs::exists(shard() / "cases" / ids()[0] / "series.csv"));
-  EXPECT_TRUE(contains(key, "binary=")) << key;
+TEST_F(Folder, ACaseRecordHoldsTheKeyTheSeriesHashAndTheSummaryRows) {
+  const fs::path folder = shard() / "cases" / ids()[0];
+  const std::string text = slurp(folder / "case.txt");
+  EXPECT_TRUE(contains(text, "\nfile series.csv.gz ")) << text;
+  EXPECT_TRUE(contains(text, "binary=")) << text;
+  // The matrix keeps the series compressed only, and the summary rows in the record.
+  EXPECT_FALSE(fs::exists(folder / "series.csv"));
+  EXPECT_FALSE(fs::exists(folder / "summary.csv"));
+  EXPECT_FALSE(fs::exists(folder / "key.txt"));
+  std::string why;
+  const auto record = cstab::parse_case_record(text, why);
+  ASSERT_TRUE(record) << why;
+  EXPECT_TRUE(contains(text, record->head + "summary " + std::to_string(record->summary.size()) + " ")) << text;
+  const cstab::CsvTable rows = cstab::parse_csv(record->summary, "case.txt");
+  ASSERT_EQ(rows.rows.size(), 1u);
+  EXPECT_EQ(rows.get(0, "case_id"), ids()[0]);
+  // The folder's summary.csv holds the same row (with the sweep).
+  const cstab::CsvTable all = cstab::read_csv((shard() / "summary.csv").string());
+  EXPECT_EQ(all.get(0, "case_id"), ids()[0]);
+  for (const char* column : {"status", "steps", "max_residual"}) {
+    EXPECT_FALSE(rows.get(0, column).empty()) << column;
+    EXPECT_EQ(all.get(0, column), rows.get(0, column)) << column;
+  }
+  // Any byte less, or one more, and the record is not whole.
+  EXPECT_FALSE(cstab::parse_case_record(text.substr(0, text.size() - 1), why));
+  EXPECT_TRUE(contains(why, "recorded (truncated or edited)")) << why;
+  EXPECT_FALSE(cstab::parse_case_record(text + "\n", why));
+  EXPECT_FALSE(cstab::parse_case_record(text.substr(0, text.find("\nsummary ") + 1), why));
+  EXPECT_TRUE(contains(why, "no summary line")) << why;
+}
+
+// ------------------------------------------------------------- the binary's identity
+
+// A copy of the cstab binary, execute-only (mode 0111).
+fs::path execute_only_copy(const Scratch& s) {
+  const fs::path copy = s.dir() / "cstab-x";
+  fs::copy_file(CSTAB_BINARY, copy);
+  fs::permissions(copy, fs::perms::owner_exec | fs::perms::group_exec | fs::perms::others_exec);
+  return copy;
+}
+
+TEST(BinaryIdentity, IsTheSizeAndHashOfTheFileAndUnknownIfItCannotBeRead) {
+  Scratch s;
+  const std::string bytes = slurp(CSTAB_BINARY);
+  EXPECT_EQ(cstab::binary_identity_of(CSTAB_BINARY), std::to_string(bytes.size()) + "-" + cstab::hash_hex(bytes));
+  // Deleted (or replaced) while it starts: /proc/self/exe names a file
+  // that is gone ("PATH (deleted)"); a folder; an execute-only copy (root
+  // reads it anyway).
+  EXPECT_EQ(cstab::binary_identity_of((s.dir() / "cstab (deleted)").string()), "unknown");
+  EXPECT_EQ(cstab::binary_identity_of(s.dir().string()), "unknown");
+  if (::geteuid() != 0) {
+    EXPECT_EQ(cstab::binary_identity_of(execute_only_copy(s).string()), "unknown");
+  }
+}
+
+// Issue 16: "if it cannot be read, nothing is cached": a matrix run with
+// the identity "unknown" runs every case again, the second time too.
+TEST(BinaryIdentity, AnUnreadableBinaryReusesNothing) {
+  Scratch s;
+  const std::string text =
+      "[[sweep]]\nproblems = [\"wheel\"]\nmethods = [\"pesterev\"]\nintegrators = \"rk4\"\n"
+      "step = [1e-2, 5e-3]\nt_end = 0.2\n";
+  const cstab::Expansion ex = cstab::expand_matrix(cstab::parse_matrix(text, "m.toml"), catalog());
+  ASSERT_EQ(ex.cases.size(), 2u);
+  cstab::MatrixRunOptions opt;
+  opt.out_dir = (s.dir() / "out").string();
+  opt.jobs = 1;
+  opt.matrix_text = text;
+  opt.selected_cases = ex.cases.size();
+  opt.find_problem = [](const std::string& name) -> const cstab::Problem& { return cstab::find_problem(name); };
+  opt.binary_id = cstab::binary_identity_of((s.dir() / "cstab (deleted)").string());
+  ASSERT_EQ(opt.binary_id, "unknown");
+  std::ostringstream log;
+  for (int round = 0; round < 2; ++round) {
+    const cstab::MatrixRunStats stats = cstab::run_matrix(ex.cases, opt, log, false);
+    EXPECT_EQ(stats.run, 2u) << log.str();
+    EXPECT_EQ(stats.cached, 0u) << log.str();
+  }
+  // A readable binary does not reuse what "unknown" wrote either.
+  opt.binary_id = cstab::binary_identity_of(CSTAB_BINARY);
+  EXPECT_EQ(cstab::run_matrix(ex.cases, opt, log, false).cached, 0u) << log.str();
+  EXPECT_EQ(cstab::run_matrix(ex.cases, opt, log, false).cached, 2u) << log.str();
+}
+
+// The same end to end: an execute-only copy of cstab (it runs, but cannot
+// read itself) says so and reruns every case. Root reads any file, so
+// there the test above (the identity given to the matrix) stands for it.
+TEST(BinaryIdentity, AnExecuteOnlyCstabSaysItCachesNothingAndRerunsEveryCase) {
+  if (::geteuid() == 0) GTEST_SKIP() << "running as root: an execute-only binary is still readable";
+  Scratch s;
+  const fs::path cstab = execute_only_copy(s);
+  std::ofstream(s.dir() / "m.toml") << "[[sweep]]\nproblems = [\"wheel\"]\nmethods = [\"pesterev\"]\n"
+                                       "integrators = \"rk4\"\nstep = [1e-2, 5e-3]\nt_end = 0.2\n";
+  const std::string cmd =
+      quote(cstab) + " matrix " + quote(s.dir() / "m.toml") + " --out " + quote(s.dir() / "out") + " --no-report";
+  for (int round = 0; round < 2; ++round) {
+    const Outcome o = cstab::testing::run_shell(cmd);
+    ASSERT_EQ(o.code, 0) << o.out;
+    EXPECT_TRUE(contains(o.out, "the cstab binary cannot be read, so no result is reused")) << o.out;
+    EXPECT_TRUE(contains(o.out, "2 run, 0 cached")) << o.out;
+  }
 }
 
 }  // namespace
