@@ -694,14 +694,26 @@ TEST(BinaryIdentity, AnUnreadableBinaryReusesNothing) {
 // The same end to end: an execute-only copy of cstab (it runs, but cannot
 // read itself) says so and reruns every case. Root reads any file, so
 // there the test above (the identity given to the matrix) stands for it.
+// As root (CI, containers) an execute-only file is still readable, so the
+// runs go through `setpriv` as the unprivileged uid 65534 (util-linux, on
+// every Debian), in a scratch folder it may write to.
 TEST(BinaryIdentity, AnExecuteOnlyCstabSaysItCachesNothingAndRerunsEveryCase) {
-  if (::geteuid() == 0) GTEST_SKIP() << "running as root: an execute-only binary is still readable";
   Scratch s;
   const fs::path cstab = execute_only_copy(s);
   std::ofstream(s.dir() / "m.toml") << "[[sweep]]\nproblems = [\"wheel\"]\nmethods = [\"pesterev\"]\n"
                                        "integrators = \"rk4\"\nstep = [1e-2, 5e-3]\nt_end = 0.2\n";
-  const std::string cmd =
-      quote(cstab) + " matrix " + quote(s.dir() / "m.toml") + " --out " + quote(s.dir() / "out") + " --no-report";
+  std::string as_user;
+  if (::geteuid() == 0) {
+    fs::permissions(s.dir(), fs::perms::all);
+    fs::permissions(s.dir() / "m.toml", fs::perms::owner_read | fs::perms::owner_write | fs::perms::group_read |
+                                             fs::perms::others_read);
+    as_user = "setpriv --reuid=65534 --regid=65534 --clear-groups ";
+    // The unprivileged user cannot read the copy: the premise of the test.
+    const Outcome premise = cstab::testing::run_shell(as_user + "cat " + quote(cstab) + " > /dev/null");
+    ASSERT_NE(premise.code, 0) << "uid 65534 can read the execute-only copy: " << premise.out;
+  }
+  const std::string cmd = as_user + quote(cstab) + " matrix " + quote(s.dir() / "m.toml") + " --out " +
+                          quote(s.dir() / "out") + " --no-report";
   for (int round = 0; round < 2; ++round) {
     const Outcome o = cstab::testing::run_shell(cmd);
     ASSERT_EQ(o.code, 0) << o.out;
