@@ -105,9 +105,10 @@ class RattleFormulation final : public SelfSteppingFormulation<Model> {
     VecQ v_half = vt;
     int iterations = 0;
     if constexpr (nh > 0) {
-      // G(q_n): the end of the last step's evaluation when it is this state.
-      if (!(have_last_ && t == last_t_ && q_n == last_q_)) terms_.evaluate_position(this->model_, t, q_n);
-      const MatQH MinvGt = llt_.solve(MatQH(terms_.A.transpose()));
+      // G(q_n) and M^-1 G(q_n)^T: the end of the last step's when it is this state.
+      const bool continues = have_last_ && t == last_t_ && q_n == last_q_;
+      if (!continues) terms_.evaluate_position(this->model_, t, q_n);
+      const MatQH MinvGt = continues ? MinvG1t_ : MatQH(llt_.solve(MatQH(terms_.A.transpose())));
       const VecQ qt = q1;
       VecH lambda = VecH::Zero();
       bool converged = false;
