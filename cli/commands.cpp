@@ -174,6 +174,8 @@ const std::vector<Command>& commands() {
       {"stability", "Step x gain map of a method and its measured stability boundary per step",
        "Writes DIR/stability.csv, DIR/boundary.csv and, with gnuplot, DIR/stability.png/.svg.", declare_stability,
        cmd_stability},
+      {"score", "Score a trajectory computed elsewhere: the metrics of run, from a CSV of t and the coordinates",
+       "Writes DIR/summary.csv and DIR/series.csv with run's columns (docs/score.md).", declare_score, cmd_score},
       {"matrix", "Run a benchmark matrix (default: the embedded one; docs/matrix.md)",
        "Exit 128+N if interrupted by signal N (finished cases are kept; run again to resume).", declare_matrix,
        cmd_matrix},

@@ -35,5 +35,9 @@ int cmd_gate(const Args& args);
 // stability boundaries.
 void declare_stability(Args& args);
 int cmd_stability(const Args& args);
+// cstab score (score_command.cpp): the metrics of run for a trajectory
+// computed elsewhere.
+void declare_score(Args& args);
+int cmd_score(const Args& args);
 
 }  // namespace cstab::cli

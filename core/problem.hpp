@@ -88,6 +88,13 @@ class Problem {
   // nullptr if the problem has neither.
   virtual std::unique_ptr<Formulation> make_unconstrained() const { return nullptr; }
 
+  // A formulation whose state is exactly the canonical coordinates (its
+  // to_canonical is the identity), for scoring a trajectory computed
+  // elsewhere (`cstab score`): its residuals() evaluate the constraints at
+  // a canonical state. nullptr if no formulation of the problem has the
+  // canonical coordinates as its state.
+  virtual std::unique_ptr<Formulation> make_observer() const { return nullptr; }
+
   // Energy of a canonical state (only if info().has_energy).
   virtual double energy(double /*t*/, const double* /*canonical*/) const { return 0; }
   // First integrals other than energy, in info().first_integrals order.

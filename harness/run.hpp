@@ -63,8 +63,8 @@ struct RunResult {
   double fail_time = std::numeric_limits<double>::quiet_NaN();
   double t_end = 0, t_reached = 0;
   StepSettings step;
-  long steps = 0, rejected_steps = 0, rhs_evals = 0;
-  double wall_seconds = 0;     // integration alone (observation excluded)
+  long steps = 0, rejected_steps = 0, rhs_evals = 0;  // -1: not recorded (a scored trajectory)
+  double wall_seconds = 0;     // integration alone (observation excluded); NaN: not known
   double observe_seconds = 0;  // time spent in observers
   std::vector<ConstraintMetrics> constraints;
   double max_residual = 0, final_residual = 0;

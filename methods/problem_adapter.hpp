@@ -6,6 +6,7 @@
 // or model is a compile error here, before anything else of it is built.
 #pragma once
 
+#include <cmath>
 #include <memory>
 #include <stdexcept>
 #include <string>
@@ -57,6 +58,21 @@ class ProblemAdapter final : public Problem {
     }
   }
 
+  // The first of the mechanical and the state-space form whose state is the
+  // canonical one (checked at a generic state, not assumed from the class).
+  std::unique_ptr<Formulation> make_observer() const override {
+    std::unique_ptr<Formulation> f;
+    if constexpr (contracts::HasMechanical<P>) {
+      f = std::make_unique<UnconstrainedMechanical<std::decay_t<decltype(p_.mechanical())>>>(p_.mechanical());
+      if (state_is_canonical(*f)) return f;
+    }
+    if constexpr (contracts::HasStateSpace<P>) {
+      f = std::make_unique<UnconstrainedAffine<std::decay_t<decltype(p_.state_space())>>>(p_.state_space());
+      if (state_is_canonical(*f)) return f;
+    }
+    return nullptr;
+  }
+
   // The optional observables: used when declared with the exact signature
   // (a member of that name with another one does not compile, see above).
   double energy(double t, const double* c) const override {
@@ -89,6 +105,19 @@ class ProblemAdapter final : public Problem {
     const std::string why = why_not(method);
     if (!why.empty()) throw UsageError("--method " + method + ": does not apply to problem '" +
                                        info_.name + "': " + why);
+  }
+
+  // True if `f`'s state has the canonical coordinates' size and its
+  // to_canonical returns it unchanged: at the initial state moved off it by
+  // perturb_initial_state's pattern, so no component is special.
+  bool state_is_canonical(const Formulation& f) const {
+    const size_t n = info_.coordinates.size();
+    if (size_t(f.dimension()) != n) return false;
+    std::vector<double> y(n), c(n);
+    f.initial_state(y.data());
+    for (size_t i = 0; i < n; ++i) y[i] += 0.125 * std::sin(double(i + 1));
+    f.to_canonical(0.0, y.data(), c.data());
+    return c == y;
   }
 
   // What info() promises that only run time can compare with the class:
