@@ -66,8 +66,12 @@ void expect_score_reproduces_run(const Case& c) {
   const RunResult run = run_case(problem, cfg, (s.dir() / "run").string());
   ASSERT_EQ(run.status, "ok") << run.reason;
   // What the comparison covers: a fitted drift exponent where the horizon allows one.
-  if (run.has_energy && c.t_end >= 4 * cfg.drift_fit_from) EXPECT_FALSE(std::isnan(run.energy_drift_exponent));
-  if (c.perturb > 0) EXPECT_GT(run.initial_residual, 1e-5);
+  if (run.has_energy && c.t_end >= 4 * cfg.drift_fit_from) {
+    EXPECT_FALSE(std::isnan(run.energy_drift_exponent));
+  }
+  if (c.perturb > 0) {
+    EXPECT_GT(run.initial_residual, 1e-5);
+  }
 
   ScoreConfig sc;
   sc.problem = c.problem;
