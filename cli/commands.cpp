@@ -174,6 +174,9 @@ const std::vector<Command>& commands() {
       {"stability", "Step x gain map of a method and its measured stability boundary per step",
        "Writes DIR/stability.csv, DIR/boundary.csv and, with gnuplot, DIR/stability.png/.svg.", declare_stability,
        cmd_stability},
+      {"tune", "Cheapest gain and step/tolerance of a method that reaches a target (harness/tune.hpp)",
+       "Writes DIR/tune.csv, DIR/best.csv and, with gnuplot, DIR/tune.png. An unreachable target is a recorded "
+       "result (exit 0; best.csv says unreachable).", declare_tune, cmd_tune},
       {"matrix", "Run a benchmark matrix (default: the embedded one; docs/matrix.md)",
        "Exit 128+N if interrupted by signal N (finished cases are kept; run again to resume).", declare_matrix,
        cmd_matrix},

@@ -35,5 +35,8 @@ int cmd_gate(const Args& args);
 // stability boundaries.
 void declare_stability(Args& args);
 int cmd_stability(const Args& args);
+// cstab tune (tune_command.cpp): the cheapest gain and step/tolerance for a target.
+void declare_tune(Args& args);
+int cmd_tune(const Args& args);
 
 }  // namespace cstab::cli
