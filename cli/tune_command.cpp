@@ -46,8 +46,8 @@ void declare_tune(Args& a) {
       .value("--blowup", "B", "residual above which a run is diverged (never reaches the target)",
              format_short(r.blowup))
       .value("--prune-ratio", "R",
-             "a gain stops walking to finer steps/tols once the next is predicted to cost more than R x the best "
-             "so far (0: never)",
+             "a gain stops walking to finer steps/tols once the next is predicted to take more than R x the best's "
+             "RHS evaluations (0: never)",
              format_short(d.prune_ratio))
       .value("--max-runs", "N", "refuse a search box (gains x steps x repeats) of more runs than this",
              std::to_string(d.max_runs))
@@ -69,7 +69,7 @@ TuneConfig read_tune(const Args& args, const Problem& problem) {
   b.integrator = args.require("--integrator");
   const IntegratorInfo& integ = find_integrator(b.integrator);
   b.params = args.pairs("--param");
-  b.t_end = args.end_time("--t-end", problem.info());
+  b.t_end = resolve_end_time(args.get("--t-end"), problem.info(), "--t-end");
   b.perturb = args.number("--perturb");
   b.blowup = args.number("--blowup");
   if (!(b.blowup > 0)) throw UsageError("--blowup: must be > 0");
@@ -95,6 +95,14 @@ TuneConfig read_tune(const Args& args, const Problem& problem) {
 }
 
 std::string cell(double v) { return std::isfinite(v) ? format_exact(v) : ""; }
+
+// 4 significant digits for the tables people read; "-" for none.
+std::string g4(double v) {
+  if (!std::isfinite(v)) return "-";
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.4g", v);
+  return buf;
+}
 
 }  // namespace
 
@@ -164,13 +172,15 @@ int cmd_tune(const Args& args) {
                 format_short(cfg.target).c_str(), std::isfinite(closest) ? format_3g(closest).c_str() : "none");
   } else {
     std::printf("best: %s = %s, %s = %s: %s = %s, wall %.4g s (median of %d), %ld rhs evals\n", gname.c_str(),
-                format_short(best.gain).c_str(), level_name.c_str(), format_short(best.level).c_str(),
+                g4(best.gain).c_str(), level_name.c_str(), g4(best.level).c_str(),
                 cfg.measure.c_str(), format_3g(best.value).c_str(), best.wall, best.repeats, best.rhs_evals);
     std::printf("flat optimum: %d gain(s) within 20 %% of the best cost, %s in [%s, %s]\n", res.flat_count,
-                gname.c_str(), format_short(res.flat_min).c_str(), format_short(res.flat_max).c_str());
+                gname.c_str(), g4(res.flat_min).c_str(), g4(res.flat_max).c_str());
+    if (res.gains.size() > 1 && (best.gain == res.gains.front() || best.gain == res.gains.back()))
+      std::printf("note: the best gain is at the edge of the search box; a wider --gains may find a cheaper one\n");
     std::printf("cost against gain at %s = %s (cheapest: each gain's first %s that reaches)\n", level_name.c_str(),
-                format_short(best.level).c_str(), level_name.c_str());
-    std::printf("  %-12s %-10s %-8s %-11s %-10s %-10s %s\n", gname.c_str(), cfg.measure.c_str(), "reached",
+                g4(best.level).c_str(), level_name.c_str());
+    std::printf("  %-12s %-10s %-8s %-11s %-10s %-14s %s\n", gname.c_str(), cfg.measure.c_str(), "reached",
                 "wall (s)", "rhs", ("cheapest " + level_name).c_str(), "cheapest cost / best");
     for (double g : res.gains) {
       const TuneRun* at = nullptr;
@@ -180,11 +190,10 @@ int cmd_tune(const Args& args) {
           if (r.level == best.level) at = &r;
           if (r.reached) own = &r;
         }
-      std::printf("  %-12s %-10s %-8s %-11s %-10s %-10s %s\n", format_short(g).c_str(),
-                  at ? format_3g(at->value).c_str() : "-",
+      std::printf("  %-12s %-10s %-8s %-11s %-10s %-14s %s\n", g4(g).c_str(), at ? g4(at->value).c_str() : "-",
                   at ? (at->reached ? "yes" : at->status == "ok" ? "no" : at->status.c_str()) : "-",
-                  at ? format_3g(at->wall).c_str() : "-", at ? std::to_string(at->rhs_evals).c_str() : "-",
-                  own ? format_short(own->level).c_str() : "-", own ? format_3g(own->cost / best.cost).c_str() : "-");
+                  at ? g4(at->wall).c_str() : "-", at ? std::to_string(at->rhs_evals).c_str() : "-",
+                  own ? g4(own->level).c_str() : "-", own ? g4(own->cost / best.cost).c_str() : "-");
     }
   }
   if (!args.has("--no-plot") && ok && std::system("command -v gnuplot >/dev/null 2>&1") == 0) {

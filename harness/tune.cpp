@@ -46,7 +46,7 @@ double tune_measure(const RunResult& r, const std::string& measure) {
 std::vector<double> default_tune_gains(const ParamSpec& gain) {
   std::vector<double> out;
   for (int i = -6; i <= 6; ++i) {
-    double g = gain.default_value * std::pow(10.0, i / 4.0);
+    double g = std::stod(format_3g(gain.default_value * std::pow(10.0, i / 4.0)));  // 3 digits: 47.4, 84.4
     if (gain.bound == Bound::kRange || gain.bound == Bound::kInteger) g = std::clamp(g, gain.lower, gain.upper);
     g = std::min(g, gain.max_value);
     if (param_value_problem(gain, g).empty()) out.push_back(g);
@@ -57,7 +57,7 @@ std::vector<double> default_tune_gains(const ParamSpec& gain) {
 std::vector<double> default_tune_levels(bool fixed_step) {
   std::vector<double> out;
   if (fixed_step)
-    for (int i = 0; i <= 12; ++i) out.push_back(std::pow(10.0, -1.0 - i / 4.0));
+    for (int i = 0; i <= 12; ++i) out.push_back(std::stod(format_3g(std::pow(10.0, -1.0 - i / 4.0))));
   else
     for (int i = 0; i <= 8; ++i) out.push_back(std::pow(10.0, -3.0 - i));
   return out;
@@ -148,8 +148,9 @@ TuneResult tune(const Problem& problem, const TuneConfig& cfg) {
       if (cfg.prune_ratio > 0 && res.reachable && last[gi] >= 0) {
         const TuneRun& prev = res.runs[last[gi]];
         if (prev.status == "ok") {
-          const double predicted = prev.cost * (res.fixed_step ? res.levels[li - 1] / level : 1.0);
-          if (predicted > cfg.prune_ratio * res.best.cost) {
+          // In RHS evaluations, which wall time follows without its noise.
+          const double predicted = double(prev.rhs_evals) * (res.fixed_step ? res.levels[li - 1] / level : 1.0);
+          if (predicted > cfg.prune_ratio * double(res.best.rhs_evals)) {
             done[gi] = true;
             continue;
           }

@@ -8,9 +8,10 @@
 // target. The assumption: for one gain, the cost grows as the level gets
 // finer (more steps), so the first level that reaches is that gain's
 // cheapest. A gain also stops once its next level is predicted to cost more
-// than prune_ratio times the best cost found so far (fixed step: its cost
-// at this level times h_this / h_next; adaptive: at least its cost at this
-// level): such a level cannot be the best, nor within 20 % of it.
+// than prune_ratio times the best found so far, in RHS evaluations (noise-
+// free; fixed step: its count at this level times h_this / h_next;
+// adaptive: at least its count at this level): such a level cannot be the
+// best, nor within 20 % of it, if wall time follows RHS evaluations.
 #pragma once
 
 #include <limits>
@@ -67,9 +68,10 @@ struct TuneResult {
 };
 
 // 13 log-spaced values over 3 decades around the default (default x
-// 10^(-1.5 .. 1.5)), clipped to the spec's bound.
+// 10^(-1.5 .. 1.5), 3 significant digits), clipped to the spec's bound.
 std::vector<double> default_tune_gains(const ParamSpec& gain);
-// Fixed step: 13 steps 1e-1 .. 1e-4; adaptive: 9 tolerances 1e-3 .. 1e-11.
+// Fixed step: 13 steps 1e-1 .. 1e-4 (4 a decade, 3 significant digits);
+// adaptive: 9 tolerances 1e-3 .. 1e-11.
 std::vector<double> default_tune_levels(bool fixed_step);
 
 // Checks the configuration (throws UsageError naming the flag) and makes

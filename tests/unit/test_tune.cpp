@@ -177,8 +177,10 @@ TEST(TuneSearch, DefaultGridsAreLogSpacedAndBounded) {
   const ParamSpec lambda{"lambda", 1500, Bound::kPositive, "", ParamRole::kRate};
   const auto g = default_tune_gains(lambda);
   ASSERT_EQ(g.size(), 13u);
-  EXPECT_NEAR(g.front(), 1500 / std::pow(10, 1.5), 1e-9);
-  EXPECT_NEAR(g.back(), 1500 * std::pow(10, 1.5), 1e-6);
+  EXPECT_DOUBLE_EQ(g.front(), 47.4);  // 1500 x 10^-1.5, 3 digits
+  EXPECT_DOUBLE_EQ(g.back(), 47400);
+  EXPECT_DOUBLE_EQ(g[6], 1500);
+  for (size_t i = 1; i < g.size(); ++i) EXPECT_NEAR(g[i] / g[i - 1], std::pow(10, 0.25), 0.01);
   const ParamSpec ranged = ranged_param("x", 0.5, 0.1, 1, "");
   for (double v : default_tune_gains(ranged)) {
     EXPECT_GE(v, 0.1);
