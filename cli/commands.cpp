@@ -176,6 +176,9 @@ const std::vector<Command>& commands() {
        cmd_stability},
       {"score", "Score a trajectory computed elsewhere: the metrics of run, from a CSV of t and the coordinates",
        "Writes DIR/summary.csv and DIR/series.csv with run's columns (docs/score.md).", declare_score, cmd_score},
+      {"tune", "Cheapest gain and step/tolerance of a method that reaches a target (harness/tune.hpp)",
+       "Writes DIR/tune.csv, DIR/best.csv and, with gnuplot, DIR/tune.png. An unreachable target is a recorded "
+       "result (exit 0; best.csv says unreachable).", declare_tune, cmd_tune},
       {"matrix", "Run a benchmark matrix (default: the embedded one; docs/matrix.md)",
        "Exit 128+N if interrupted by signal N (finished cases are kept; run again to resume).", declare_matrix,
        cmd_matrix},

@@ -39,5 +39,8 @@ int cmd_stability(const Args& args);
 // computed elsewhere.
 void declare_score(Args& args);
 int cmd_score(const Args& args);
+// cstab tune (tune_command.cpp): the cheapest gain and step/tolerance for a target.
+void declare_tune(Args& args);
+int cmd_tune(const Args& args);
 
 }  // namespace cstab::cli

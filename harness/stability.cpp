@@ -69,6 +69,12 @@ ParamSpec gain_spec(const Problem& problem, const StabilityConfig& cfg) {
   throw UsageError("--gain-param " + cfg.gain_param + ": method '" + cfg.base.method + "' has no such parameter");
 }
 
+void apply_gain(RunConfig& rc, const ParamSpec& spec, double gain) {
+  const std::string value = format_short(gain);
+  rc.params.emplace_back(spec.name, value);
+  for (const auto& tied : spec.swept_with) rc.params.emplace_back(tied, value);  // e.g. beta = alpha
+}
+
 namespace {
 
 StabilityPoint run_point(const Problem& problem, const StabilityConfig& cfg, double h, double gain) {
@@ -77,9 +83,7 @@ StabilityPoint run_point(const Problem& problem, const StabilityConfig& cfg, dou
   rc.step.step = h;
   rc.write_series = false;
   rc.ref_time = 0;
-  const std::string value = format_short(gain);
-  rc.params.emplace_back(spec.name, value);
-  for (const auto& tied : spec.swept_with) rc.params.emplace_back(tied, value);  // e.g. beta = alpha
+  apply_gain(rc, spec, gain);
   const RunResult r = run_case(problem, rc, "");
   StabilityPoint p;
   p.step = h;

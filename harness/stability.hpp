@@ -46,6 +46,9 @@ struct StabilityBoundary {
 // The gain a stability map sweeps: cfg.gain_param, or the method's declared
 // gain (find_gain) when that is empty. Throws UsageError if there is none.
 ParamSpec gain_spec(const Problem& problem, const StabilityConfig& cfg);
+// Sets the gain `spec` to `gain` in `rc.params`, and every parameter swept
+// with it (spec.swept_with, e.g. Baumgarte's beta with alpha) to the same value.
+void apply_gain(RunConfig& rc, const ParamSpec& spec, double gain);
 
 std::vector<StabilityPoint> stability_map(const Problem& problem, const StabilityConfig& config);
 std::vector<StabilityBoundary> stability_boundaries(const Problem& problem, const StabilityConfig& config);

@@ -39,6 +39,8 @@ trap 'rm -f "$tmp"' EXIT
     echo '```'
     "$B" "$c" --help
     echo '```'
+    # Worked examples of a command, measured, kept beside the generated help.
+    if [ -f "docs/cli-$c.md" ]; then echo; cat "docs/cli-$c.md"; fi
   done
 } >"$tmp"
 mv "$tmp" docs/cli.md
