@@ -2,7 +2,8 @@
 # Installs the Debian 12 packages cstab needs (plus any given as arguments), only those missing.
 set -euo pipefail
 packages=(g++ cmake make libeigen3-dev libsundials-dev libgsl-dev libbenchmark-dev libfccp-dev libtomlplusplus-dev
-          gnuplot-nox googletest libgtest-dev libcli11-dev zlib1g-dev parallel "$@")
+          gnuplot-nox googletest libgtest-dev libcli11-dev zlib1g-dev parallel
+          libsimbody-dev libmujoco-dev "$@")
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
