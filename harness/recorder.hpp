@@ -9,6 +9,9 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <memory>
 #include <limits>
 #include <string>
 #include <vector>
@@ -199,6 +202,39 @@ class Recorder {
   double fit_from_ = 0, fit_ratio_ = 1, next_checkpoint_ = 0;
   std::vector<double> checkpoint_t_;
   std::vector<std::vector<double>> checkpoint_max_;
+};
+
+// A run's two output files in `out_dir` (nothing if it is empty), opened
+// before anything is computed so that a folder that cannot be written is
+// bad input (UsageError) and nothing is written; commit() writes the
+// summary row last, and removes a series.csv of an earlier run into the
+// folder when this one writes none.
+class RunOutputs {
+ public:
+  RunOutputs(const std::string& out_dir, bool write_series) : dir_(out_dir) {
+    if (dir_.empty()) return;
+    std::error_code ec;
+    std::filesystem::create_directories(dir_, ec);
+    if (ec) throw UsageError("--out " + dir_ + ": cannot create folder: " + ec.message());
+    try {
+      summary_ = std::make_unique<AtomicFile>(dir_ + "/summary.csv");
+      if (write_series) series_ = std::make_unique<AtomicFile>(dir_ + "/series.csv");
+    } catch (const std::exception& e) {
+      throw UsageError(std::string("--out ") + dir_ + ": " + e.what());
+    }
+  }
+  AtomicFile* series() { return series_.get(); }
+  void commit(const RunResult& result) {
+    if (dir_.empty()) return;
+    if (series_) series_->commit();
+    summary_->write(key_value_csv(result.summary_row()));
+    summary_->commit();
+    if (!series_) std::remove((dir_ + "/series.csv").c_str());
+  }
+
+ private:
+  std::string dir_;
+  std::unique_ptr<AtomicFile> series_, summary_;
 };
 
 }  // namespace cstab

@@ -109,18 +109,7 @@ RunResult run_case(const Problem& registered, const RunConfig& cfg, const std::s
   }
   if (ref_time > 0) result.ref_time = ref_time;
 
-  std::unique_ptr<AtomicFile> series, summary;
-  if (!out_dir.empty()) {
-    std::error_code ec;
-    std::filesystem::create_directories(out_dir, ec);
-    if (ec) throw UsageError("--out " + out_dir + ": cannot create folder: " + ec.message());
-    try {
-      summary = std::make_unique<AtomicFile>(out_dir + "/summary.csv");
-      if (cfg.write_series) series = std::make_unique<AtomicFile>(out_dir + "/series.csv");
-    } catch (const std::exception& e) {
-      throw UsageError(std::string("--out ") + out_dir + ": " + e.what());
-    }
-  }
+  RunOutputs outputs(out_dir, cfg.write_series);
 
   // ---- integrate ----
   const int n = form->dimension();
@@ -128,7 +117,7 @@ RunResult run_case(const Problem& registered, const RunConfig& cfg, const std::s
   form->initial_state(y0.data());
   if (cfg.perturb > 0) perturb_initial_state(cfg.perturb, n, y0.data());
   const double sample_every = cfg.sample_every > 0 ? cfg.sample_every : cfg.t_end / 1000;
-  Recorder recorder(problem, *form, result, series.get(), sample_every, cfg.drift_fit_from, cfg.t_end);
+  Recorder recorder(problem, *form, result, outputs.series(), sample_every, cfg.drift_fit_from, cfg.t_end);
 
   std::vector<double> targets = cfg.times;
   if (ref_time > 0) targets.push_back(ref_time);
@@ -216,13 +205,7 @@ RunResult run_case(const Problem& registered, const RunConfig& cfg, const std::s
   for (auto& kv : integrator->statistics()) result.extra.push_back(std::move(kv));
 
   // ---- write ----
-  if (!out_dir.empty()) {
-    if (series) series->commit();
-    summary->write(key_value_csv(result.summary_row()));
-    summary->commit();
-    // A series.csv of an earlier run into this folder does not belong to this summary.
-    if (!series) std::remove((out_dir + "/series.csv").c_str());
-  }
+  outputs.commit(result);
   return result;
 }
 

@@ -289,23 +289,12 @@ RunResult score_trajectory(const Problem& registered, const ScoreConfig& cfg, co
   }
   if (ref_time > 0) result.ref_time = ref_time;
 
-  std::unique_ptr<AtomicFile> series, summary;
-  if (!out_dir.empty()) {
-    std::error_code ec;
-    std::filesystem::create_directories(out_dir, ec);
-    if (ec) throw UsageError("--out " + out_dir + ": cannot create folder: " + ec.message());
-    try {
-      summary = std::make_unique<AtomicFile>(out_dir + "/summary.csv");
-      if (cfg.write_series) series = std::make_unique<AtomicFile>(out_dir + "/series.csv");
-    } catch (const std::exception& e) {
-      throw UsageError(std::string("--out ") + out_dir + ": " + e.what());
-    }
-  }
+  RunOutputs outputs(out_dir, cfg.write_series);
 
   // ---- observe every row, as `cstab run` observes every step ----
   const double span = tr.t.back() - tr.t.front();
   const double sample_every = cfg.sample_every > 0 ? cfg.sample_every : (span > 0 ? span / 1000 : 1);
-  Recorder recorder(problem, *form, result, series.get(), sample_every, cfg.drift_fit_from, tr.t.back());
+  Recorder recorder(problem, *form, result, outputs.series(), sample_every, cfg.drift_fit_from, tr.t.back());
   std::string ref_interpolation;
   bool alive = true;
   for (size_t r = 0; r < tr.rows() && alive; ++r) {
@@ -345,12 +334,7 @@ RunResult score_trajectory(const Problem& registered, const ScoreConfig& cfg, co
                   {"initial_state_deviation", format_exact(deviation)}};
 
   // ---- write ----
-  if (!out_dir.empty()) {
-    if (series) series->commit();
-    summary->write(key_value_csv(result.summary_row()));
-    summary->commit();
-    if (!series) std::remove((out_dir + "/series.csv").c_str());
-  }
+  outputs.commit(result);
   return result;
 }
 

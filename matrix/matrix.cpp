@@ -395,7 +395,8 @@ const std::vector<std::string>& known_keys() {
   static const std::vector<std::string> keys = {
       "name", "problems", "methods", "formulations", "integrators", "step", "tol", "rtol", "atol",
       "t_end", "ref_time", "times", "sample_every", "blowup", "observe_every", "series", "keep_series", "repeats",
-      "timeout", "repeat_if_under", "work_precision", "overlay", "optional", "perturb", "max_steps"};
+      "timeout", "repeat_if_under", "work_precision", "overlay", "optional", "perturb", "max_steps",
+      "external", "external_name"};
   return keys;
 }
 
@@ -670,6 +671,11 @@ class Expander {
     read_name(set, number, p);
     const size_t notes_before = out_.notes.size(), cases_before = out_.cases.size();
     const size_t duplicates_before = duplicates_;
+    if (set.find("external") || set.find("external_name")) {
+      expand_external(set, p);
+      finish_sweep(p, notes_before, cases_before, duplicates_before);
+      return;
+    }
     resolve_problems(set, p);
     resolve_methods(set, p);
     resolve_integrators(set, p);
@@ -1160,6 +1166,122 @@ class Expander {
               (e.params.empty() ? "" : " " + e.params) +
               (e.problem_params.empty() ? "" : " (" + e.problem_params + ")");
     c.cost_estimate = estimate_cost(cfg, integ, p.repeats);
+    out_.cases.push_back(std::move(c));
+  }
+
+  // An external sweep (keys `external`, `external_name`): an outside
+  // program is the method and the integrator. Its command template is
+  // completed per case ({problem}, {t_end}, {step} or {tol}, and {out}, the
+  // trajectory file it must write, filled in by the worker) and the case
+  // scores what it wrote (harness/score.hpp).
+  void expand_external(const Settings& set, SweepPlan& p) {
+    const MatrixValue* cmd = set.scalar("external", Kind::kString);
+    const MatrixValue* name = set.scalar("external_name", Kind::kString);
+    const MatrixEntry* first = set.find("external") ? set.find("external") : set.find("external_name");
+    if (!cmd) throw MatrixError(first->where, "external_name: given without 'external' (the command to run)");
+    if (!name) throw MatrixError(first->where, "external: needs 'external_name' (the method column of its cases)");
+    for (const char* key : {"methods", "integrators", "formulations", "perturb", "times", "observe_every"})
+      if (const MatrixEntry* e = set.find(key))
+        throw MatrixError(e->where, std::string(key) + ": not for an external sweep (its command is the method "
+                                                        "and the integrator)");
+    if (!set.params("param.").empty())
+      throw MatrixError(set.params("param.").front()->where, "param.*: not for an external sweep (pass settings in "
+                                                             "the command)");
+    if (name->text.empty() || name->text.find_first_of(",\"\n ;[]/") != std::string::npos)
+      throw MatrixError(name->where, "external_name: must be non-empty, without spaces, commas, quotes, ;, / or []");
+    for (const auto& m : catalog_.methods)
+      if (m.name == name->text)
+        throw MatrixError(name->where, "external_name: '" + name->text + "' is a built-in method's name");
+    read_step_settings(set, p);
+    if (!p.rtols.empty())
+      throw MatrixError(set.find("rtol")->where, "rtol/atol: an external sweep takes 'tol' (substituted as {tol})");
+    check_template(cmd, p);
+    resolve_problems(set, p);
+    read_t_ends(set, p);
+    read_run_settings(set, p);
+    p.problem_params = read_param_choices(set, p, "problem_param.");
+    std::vector<StepSettings> settings;
+    for (const auto* v : p.steps) settings.push_back({v->number, 0, 0});
+    for (const auto* v : p.tols) settings.push_back({0, v->number, v->number});
+    if (settings.empty()) settings.push_back({});
+    for (const Problem* registered : p.problems)
+      for_each_variant(p, *registered, [&](const Problem& problem) {
+        const ProblemInfo& info = problem.info();
+        for (const TEnd& te : p.t_ends) {
+          double t_end = te.value;
+          if (te.mode == "ref") t_end = info.reference_time > 0 ? info.reference_time : info.default_t_end;
+          if (te.mode == "default") t_end = info.default_t_end;
+          for (const StepSettings& st : settings) add_external_case(p, info, name->text, cmd->text, t_end, st);
+        }
+      });
+  }
+
+  // The placeholders: known ones only, {out} required, {step}/{tol} only with their list.
+  static void check_template(const MatrixValue* cmd, const SweepPlan& p) {
+    const std::string& t = cmd->text;
+    if (t.find("{out}") == std::string::npos)
+      throw MatrixError(cmd->where, "external: the command must write its trajectory to {out}");
+    for (size_t at = t.find('{'); at != std::string::npos; at = t.find('{', at + 1)) {
+      const size_t close = t.find('}', at);
+      const std::string key = t.substr(at, close == std::string::npos ? std::string::npos : close - at + 1);
+      if (key != "{out}" && key != "{problem}" && key != "{t_end}" && key != "{step}" && key != "{tol}")
+        throw MatrixError(cmd->where, "external: unknown placeholder '" + key +
+                                          "' (known: {problem}, {t_end}, {step}, {tol}, {out})");
+      if ((key == "{step}" && p.steps.empty()) || (key == "{tol}" && p.tols.empty()))
+        throw MatrixError(cmd->where, "external: " + key + " used but the sweep has no '" +
+                                          key.substr(1, key.size() - 2) + "' list");
+    }
+  }
+
+  static std::string replaced(std::string text, const std::string& key, const std::string& value) {
+    for (size_t at = text.find(key); at != std::string::npos; at = text.find(key, at + value.size()))
+      text.replace(at, key.size(), value);
+    return text;
+  }
+
+  void add_external_case(const SweepPlan& p, const ProblemInfo& info, const std::string& name,
+                         const std::string& command, double t_end, const StepSettings& st) {
+    MatrixCase c;
+    RunConfig& cfg = c.config;
+    cfg.problem = info.name;
+    cfg.problem_params = p.given_problem_params;
+    cfg.method = name;
+    cfg.integrator = "external";
+    cfg.step = st;
+    cfg.t_end = t_end;
+    cfg.sample_every = p.sample_every;
+    cfg.ref_time = p.ref_time;
+    cfg.blowup = p.blowup;
+    cfg.write_series = p.series;
+    c.timeout = p.timeout;
+    c.repeat_if_under = p.repeat_if_under;
+    c.keep_series = p.keep_series;
+    std::string problem_arg = info.name;
+    for (const auto& [k, v] : cfg.problem_params) problem_arg += " --problem-param " + k + "=" + v;
+    c.external = replaced(replaced(command, "{problem}", problem_arg), "{t_end}", format_short(t_end));
+    if (st.step > 0) c.external = replaced(c.external, "{step}", format_short(st.step));
+    if (st.rtol > 0) c.external = replaced(c.external, "{tol}", format_short(st.rtol));
+    c.config_text = canonical_text(cfg, p.repeats, p.timeout_text, p.repeat_if_under) + "external=" + c.external + "\n";
+    CaseEntry& e = c.entry;
+    e.id = hash_hex(c.config_text);
+    if (!seen_ids_.insert(e.id).second) {
+      ++duplicates_;
+      return;
+    }
+    e.index = out_.cases.size();
+    e.sweep = p.name;
+    e.problem = cfg.problem;
+    e.problem_params = join_params(cfg.problem_params);
+    e.method = name;
+    e.integrator = cfg.integrator;
+    if (st.step > 0) e.setting = "step=" + format_short(st.step);
+    if (st.rtol > 0) e.setting = "tol=" + format_short(st.rtol);
+    e.t_end = t_end;
+    e.repeats = p.repeats;
+    e.work_precision = p.work_precision;
+    e.overlay = p.overlay;
+    e.curve = name + "/external" + (e.problem_params.empty() ? "" : " (" + e.problem_params + ")");
+    c.cost_estimate = t_end * p.repeats;
     out_.cases.push_back(std::move(c));
   }
 

@@ -132,6 +132,10 @@ struct MatrixCase {
   // --keep-series); not part of the configuration: a case whose series was
   // dropped runs again when it is asked for.
   bool keep_series = false;
+  // An external case (key `external`): the shell command the worker runs,
+  // its placeholders filled but {out} (the trajectory file it must write);
+  // the case scores that trajectory. Empty: a cstab method.
+  std::string external;
   std::string config_text;   // canonical configuration; id = hash(config_text)
   double cost_estimate = 0;  // relative, for scheduling and shard balance
 };

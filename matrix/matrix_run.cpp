@@ -27,6 +27,7 @@
 #include "io/hash.hpp"
 #include "io/lock.hpp"
 #include "io/number.hpp"
+#include "matrix/external.hpp"
 #include "matrix/matrix.hpp"
 #include "matrix/provenance.hpp"
 #include "matrix/results.hpp"
@@ -188,12 +189,26 @@ std::string cache_problem(const std::string& dir, const MatrixCase& c, const std
 int run_in_worker(const MatrixCase& c, const Problem& problem, const std::string& dir, const std::string& key) {
   std::vector<Row> rows;
   int code = kExitOk;
+  const Clock::time_point start = Clock::now();
   for (int r = 0; r < c.entry.repeats; ++r) {
     RunConfig cfg = c.config;
     cfg.write_series = cfg.write_series && r == 0;
     RunResult result;
     try {
-      result = run_case(problem, cfg, r == 0 ? dir : std::string());
+      if (c.external.empty()) {
+        result = run_case(problem, cfg, r == 0 ? dir : std::string());
+      } else {
+        // The program's own deadline, before the pool's timeout kills this worker.
+        const double left = c.timeout > 0 ? 0.9 * c.timeout - std::chrono::duration<double>(Clock::now() - start).count()
+                                          : 0.0;
+        ExternalOutcome o = run_external(c, problem, dir, r == 0 ? dir : std::string(), c.timeout > 0 ? std::max(left, 1e-3) : 0.0);
+        if (o.status != Status::kOk) {
+          rows = {failure_row(c, o.status, o.reason)};
+          code = kExitFailed;
+          break;
+        }
+        result = std::move(o.result);
+      }
     } catch (const UsageError& e) {
       rows = {failure_row(c, Status::kInvalid, e.what())};
       code = kExitInvalid;

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # The bad-input table of issues 9 and 16: every kind of bad input on every
-# command (run, stability, matrix and matrix files, merge, report, gate,
+# command (run, stability, score, tune, matrix and matrix files, merge, report, gate,
 # list), with what it got: exit code, first line of stderr, number of stderr
 # lines, files left in the output folder (for the rows that damage a folder,
 # the files of that folder that changed). Markdown on stdout. Usage: bash
@@ -26,8 +26,24 @@ trap 'rm -rf "$W"' EXIT
 G="--problem wheel --method pesterev --integrator rk4 --step 1e-3 --t-end 0.05"
 A="--problem wheel --method pesterev --integrator rk8pd --rtol 1e-6 --atol 1e-6 --t-end 0.05"
 S="--problem wheel --method pesterev --integrator rk4 --gain-param lambda --steps 1e-3 --gains 10 --t-end 0.05 --no-plot"
+T="--problem pendulum --method pesterev --integrator rk4 --target 1e-6 --t-end 0.5"
 M=$W/m
 mkdir -p $M
+# Trajectories for `cstab score` (the pendulum's columns are t,x,y,xdot,ydot).
+t() { printf '%b' "$2" > $M/traj_$1.csv; }
+t good 't,x,y,xdot,ydot\n0,1,0,0,0\n0.1,1,0,0,0\n'
+t unknown_column 't,x,y,xdot,ydot,zz\n0,1,0,0,0,0\n0.1,1,0,0,0,0\n'
+t missing_column 't,x,xdot,ydot\n0,1,0,0\n0.1,1,0,0\n'
+t duplicate_column 't,x,y,x,ydot\n0,1,0,0,0\n'
+t nan 't,x,y,xdot,ydot\n0,1,0,0,0\n0.1,1,nan,0,0\n'
+t word 't,x,y,xdot,ydot\n0,1,0,0,0\n0.1,1,abc,0,0\n'
+t short_row 't,x,y,xdot,ydot\n0,1,0,0,0\n0.1,1,0,0\n'
+t not_increasing 't,x,y,xdot,ydot\n0,1,0,0,0\n0.1,1,0,0,0\n0.1,1,0,0,0\n'
+t one_row 't,x,y,xdot,ydot\n0,1,0,0,0\n'
+t empty ''
+t slider_crank 't,q,x,p,qdot,xdot,pdot\n0,0,0,0,0,0,0\n0.1,0,0,0,0,0,0\n'
+t wall_nan '# wall_seconds = nan\nt,x,y,xdot,ydot\n0,1,0,0,0\n0.1,1,0,0,0\n'
+printf 'not gzip' > $M/traj_corrupt.csv.gz
 w() { printf '%b' "$2" > $M/$1.toml; }
 w good '[[sweep]]\nproblems = ["wheel"]\nmethods = ["pesterev"]\nintegrators = "rk4"\nstep = 1e-3\nt_end = 0.05\n'
 w unknown_key '[[sweep]]\nproblems = ["wheel"]\nmethods = ["pesterev"]\nintegrators = "rk4"\nstep = 1e-3\nt_end = 0.05\nstpe = 1\n'
@@ -151,6 +167,34 @@ cases=(
 "stab_step_gt_t_end|stability ${S/--steps 1e-3/--steps 1} --out OUT"
 "stab_out_file|stability $S --out /etc/passwd"
 "stab_unknown_problem|stability ${S/wheel/nope} --out OUT"
+"score_unknown_problem|score --problem nope $M/traj_good.csv --out OUT"
+"score_missing_file|score --problem pendulum /nonexistent.csv --out OUT"
+"score_no_trajectory|score --problem pendulum --out OUT"
+"score_unknown_column|score --problem pendulum $M/traj_unknown_column.csv --out OUT"
+"score_missing_column|score --problem pendulum $M/traj_missing_column.csv --out OUT"
+"score_duplicate_column|score --problem pendulum $M/traj_duplicate_column.csv --out OUT"
+"score_nan_cell|score --problem pendulum $M/traj_nan.csv --out OUT"
+"score_word_cell|score --problem pendulum $M/traj_word.csv --out OUT"
+"score_short_row|score --problem pendulum $M/traj_short_row.csv --out OUT"
+"score_t_not_increasing|score --problem pendulum $M/traj_not_increasing.csv --out OUT"
+"score_one_row|score --problem pendulum $M/traj_one_row.csv --out OUT"
+"score_empty_file|score --problem pendulum $M/traj_empty.csv --out OUT"
+"score_other_problem|score --problem pendulum $M/traj_slider_crank.csv --out OUT"
+"score_corrupt_gz|score --problem pendulum $M/traj_corrupt.csv.gz --out OUT"
+"score_formulation|score --problem pendulum --formulation minimal $M/traj_good.csv --out OUT"
+"score_blowup_zero|score --problem pendulum --blowup 0 $M/traj_good.csv --out OUT"
+"score_wall_negative|score --problem pendulum --wall-seconds -1 $M/traj_good.csv --out OUT"
+"score_wall_in_file_nan|score --problem pendulum $M/traj_wall_nan.csv --out OUT"
+"score_ref_time_negative|score --problem pendulum --ref-time -1 $M/traj_good.csv --out OUT"
+"score_out_file|score --problem pendulum $M/traj_good.csv --out /etc/passwd"
+"tune_unknown_method|tune ${T/pesterev/nope} --out OUT"
+"tune_no_gain|tune ${T/pesterev/none} --out OUT"
+"tune_target_nan|tune ${T/--target 1e-6/--target nan} --out OUT"
+"tune_target_negative|tune ${T/--target 1e-6/--target -1} --out OUT"
+"tune_steps_garbage|tune $T --steps 1e-3,,x --out OUT"
+"tune_tols_for_rk4|tune $T --tols 1e-6 --out OUT"
+"tune_measure_unknown|tune $T --measure speed --out OUT"
+"tune_out_file|tune $T --out /etc/passwd"
 "mat_missing_file|matrix /nonexistent.toml --out OUT"
 "mat_folder_as_file|matrix /tmp --out OUT"
 "mat_two_files|matrix $M/good.toml $M/good.toml --out OUT"
