@@ -1111,6 +1111,31 @@ class Expander {
     });
   }
 
+  // The case's id and entry from its configuration; false (counted) if an
+  // identical case is already in the expansion.
+  bool claim_entry(const SweepPlan& p, MatrixCase& c) {
+    const RunConfig& cfg = c.config;
+    CaseEntry& e = c.entry;
+    e.id = hash_hex(c.config_text);
+    if (!seen_ids_.insert(e.id).second) {
+      ++duplicates_;
+      return false;
+    }
+    e.index = out_.cases.size();
+    e.sweep = p.name;
+    e.problem = cfg.problem;
+    e.problem_params = join_params(cfg.problem_params);
+    e.method = cfg.method;
+    e.formulation = cfg.formulation;
+    e.integrator = cfg.integrator;
+    e.params = join_params(cfg.params);
+    e.t_end = cfg.t_end;
+    e.repeats = p.repeats;
+    e.work_precision = p.work_precision;
+    e.overlay = p.overlay;
+    return true;
+  }
+
   // Stage 12: one case, unless an identical one is already in the expansion.
   void add_case(const SweepPlan& p, const ProblemInfo& info, const MethodInfo& method, const std::string& form,
                 const IntegratorInfo& integ, double t_end, const std::vector<std::pair<std::string, std::string>>& params,
@@ -1137,20 +1162,8 @@ class Expander {
     c.repeat_if_under = p.repeat_if_under;
     c.keep_series = p.keep_series;
     c.config_text = canonical_text(cfg, p.repeats, p.timeout_text, p.repeat_if_under);
+    if (!claim_entry(p, c)) return;
     CaseEntry& e = c.entry;
-    e.id = hash_hex(c.config_text);
-    if (!seen_ids_.insert(e.id).second) {
-      ++duplicates_;
-      return;
-    }
-    e.index = out_.cases.size();
-    e.sweep = p.name;
-    e.problem = cfg.problem;
-    e.problem_params = join_params(cfg.problem_params);
-    e.method = cfg.method;
-    e.formulation = form;
-    e.integrator = cfg.integrator;
-    e.params = join_params(cfg.params);
     if (integ.fixed_step)
       e.setting = "step=" + format_short(st.step);
     else if (st.rtol == st.atol)
@@ -1158,10 +1171,6 @@ class Expander {
     else
       e.setting = "rtol=" + format_short(st.rtol) + ";atol=" + format_short(st.atol);
     if (perturb > 0) e.setting += ";perturb=" + format_short(perturb);
-    e.t_end = t_end;
-    e.repeats = p.repeats;
-    e.work_precision = p.work_precision;
-    e.overlay = p.overlay;
     e.curve = e.method + (form.empty() ? "" : "[" + form + "]") + "/" + e.integrator +
               (e.params.empty() ? "" : " " + e.params) +
               (e.problem_params.empty() ? "" : " (" + e.problem_params + ")");
@@ -1262,24 +1271,10 @@ class Expander {
     if (st.step > 0) c.external = replaced(c.external, "{step}", format_short(st.step));
     if (st.rtol > 0) c.external = replaced(c.external, "{tol}", format_short(st.rtol));
     c.config_text = canonical_text(cfg, p.repeats, p.timeout_text, p.repeat_if_under) + "external=" + c.external + "\n";
+    if (!claim_entry(p, c)) return;
     CaseEntry& e = c.entry;
-    e.id = hash_hex(c.config_text);
-    if (!seen_ids_.insert(e.id).second) {
-      ++duplicates_;
-      return;
-    }
-    e.index = out_.cases.size();
-    e.sweep = p.name;
-    e.problem = cfg.problem;
-    e.problem_params = join_params(cfg.problem_params);
-    e.method = name;
-    e.integrator = cfg.integrator;
     if (st.step > 0) e.setting = "step=" + format_short(st.step);
     if (st.rtol > 0) e.setting = "tol=" + format_short(st.rtol);
-    e.t_end = t_end;
-    e.repeats = p.repeats;
-    e.work_precision = p.work_precision;
-    e.overlay = p.overlay;
     e.curve = name + "/external" + (e.problem_params.empty() ? "" : " (" + e.problem_params + ")");
     c.cost_estimate = t_end * p.repeats;
     out_.cases.push_back(std::move(c));
