@@ -374,6 +374,10 @@ int main(int argc, char** argv) {
     }
   }
 
+  // An --out that cannot be written is bad input, found before the run.
+  FILE* f = std::fopen(o.out.c_str(), "w");
+  if (!f) usage_error("--out: cannot write " + o.out + ": " + std::strerror(errno));
+
   mju_user_warning = on_warning;
   mju_user_error = on_error;
   mjModel* m = load_from_string(xml);
@@ -440,11 +444,6 @@ int main(int argc, char** argv) {
   }
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 
-  FILE* f = std::fopen(o.out.c_str(), "w");
-  if (!f) {
-    std::fprintf(stderr, "%s: cannot write %s: %s\n", kProgram, o.out.c_str(), std::strerror(errno));
-    return 1;
-  }
   std::fprintf(f, "# wall_seconds = %.9g\n", wall);
   std::fprintf(f, "# MuJoCo %s, %s, integrator %s, timestep %s, solref %s,%s, solimp", mj_versionString(),
                o.problem.c_str(), o.integrator.c_str(), num(o.timestep).c_str(), num(o.solref[0]).c_str(),

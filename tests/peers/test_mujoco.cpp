@@ -217,7 +217,8 @@ TEST_F(PeerMujoco, BadInputExits2WithOneLine) {
         "--problem pendulum --integrator rk4 --timestep 3e-3 --t-end 1 --every 0.01 --out x",
         "--problem pendulum --integrator rk4 --timestep 1e-3 --t-end 1 --every 0.01",
         "--problem pendulum --solref 0.02" + ok, "--problem pendulum --solref 0.02,nan" + ok,
-        "--problem pendulum --solimp 2,0.95,0.001" + ok, "--problem pendulum --bogus 1" + ok}) {
+        "--problem pendulum --solimp 2,0.95,0.001" + ok, "--problem pendulum --bogus 1" + ok,
+        "--problem pendulum --integrator rk4 --timestep 1e-3 --t-end 1 --every 0.01 --out /nonexistent/dir/x.csv"}) {
     SCOPED_TRACE(args);
     const auto o = run(std::string(kPeer) + " " + args);
     EXPECT_EQ(o.code, 2) << o.out;
