@@ -12,6 +12,7 @@
 #include "harness/integrator.hpp"
 #include "harness/run.hpp"
 #include "methods/pair.hpp"
+#include "plugin/loader.hpp"
 #include "problems/registry.hpp"
 
 namespace cstab::cli {
@@ -34,6 +35,7 @@ int cmd_list(const Args&) {
   for (const auto& p : all_problems()) {
     const auto& info = p->info();
     out << "  " << info.name << ": " << info.description << "\n";
+    if (!problem_origin(info.name).empty()) out << "    from plugin " << problem_origin(info.name) << "\n";
     for (const auto& s : p->problem_params()) out << "    --problem-param " << param_line(s) << "\n";
     out << "    coordinates: ";
     for (size_t i = 0; i < info.coordinates.size(); ++i) out << (i ? "," : "") << info.coordinates[i];
@@ -59,6 +61,7 @@ int cmd_list(const Args&) {
   out << "METHODS\n";
   for (const auto& m : all_methods()) {
     out << "  " << m.name << ": " << m.description << "\n";
+    if (!method_origin(m.name).empty()) out << "    from plugin " << method_origin(m.name) << "\n";
     for (const auto& s : m.params) out << "    --param " << param_line(s) << "\n";
   }
   out << "INTEGRATORS\n";
@@ -241,6 +244,8 @@ CommandLine::CommandLine() {
   app.require_subcommand(0, 1);
   app.footer(
       "Exit codes: 0 success, 2 bad input (one line naming what is wrong; nothing written), 1 internal error.\n"
+      "Every command takes --plugin PATH (repeatable; CSTAB_PLUGIN_PATH lists more, ':'-separated): a shared\n"
+      "object adding methods or problems (docs/plugins.md).\n"
       "`cstab COMMAND --help` or `cstab help COMMAND`: a command's options. docs/cli.md: all of them.");
   for (const auto& c : commands()) {
     CLI::App* sub = app.add_subcommand(c.name, c.summary);
@@ -334,7 +339,8 @@ std::string command_help(const std::string& command) {
   return cli.app.get_subcommand(command)->help("cstab");
 }
 
-int main_command(const std::vector<std::string>& argv) {
+int main_command(const std::vector<std::string>& given) {
+  std::vector<std::string> argv = given;
   if (argv.empty()) {
     std::cout << usage();
     return 2;
@@ -342,6 +348,15 @@ int main_command(const std::vector<std::string>& argv) {
   const bool named = argv[0].rfind("-", 0) != 0;
   const std::string prefix = named ? "cstab " + argv[0] + ": error: " : "cstab: error: ";
   try {
+    // Plugins first (any command, anywhere on the line): they add to the
+    // lists the commands and their help read.
+    const std::vector<std::string> plugin_paths = take_plugin_flags(argv);
+    load_plugins_from_environment();
+    for (const auto& path : plugin_paths) load_plugin(path);
+    if (argv.empty()) {
+      std::cout << usage();
+      return 2;
+    }
     if (named && !known_command(argv[0]))
       throw UsageError("unknown command '" + argv[0] + "' (known: " + command_names() + ")");
     CommandLine cli;

@@ -15,6 +15,7 @@
 #include "matrix/provenance.hpp"
 #include "report/report.hpp"
 #include "methods/pair.hpp"
+#include "plugin/loader.hpp"
 #include "problems/registry.hpp"
 
 namespace cstab::cli {
@@ -165,6 +166,16 @@ work_precision = false
 optional = true
 )";
 
+// The file's `plugins` (relative paths from the file's folder), loaded
+// before it expands so that its sweeps may name what they add.
+void load_matrix_plugins(const MatrixFile& file, const std::string& file_path) {
+  const std::filesystem::path base = std::filesystem::path(file_path).parent_path();
+  for (const std::string& p : matrix_plugins(file)) {
+    const std::filesystem::path path(p);
+    load_plugin(path.is_absolute() || base.empty() ? p : (base / path).string());
+  }
+}
+
 MatrixCatalog registry_catalog() {
   MatrixCatalog catalog;
   for (const auto& p : all_problems()) catalog.problems.push_back(p.get());
@@ -298,6 +309,7 @@ int cmd_matrix(const Args& args) {
   const bool from_file = args.has("FILE");
   const MatrixFile file = from_file ? read_matrix_file(args.get("FILE"))
                                     : parse_matrix(default_matrix_text(), "<default matrix>");
+  load_matrix_plugins(file, from_file ? args.get("FILE") : "");
   const Expansion expansion = expand_matrix(file, registry_catalog());
   int shard_k = 1, shard_n = 1;
   if (args.has("--shard")) std::tie(shard_k, shard_n) = parse_shard(args.require("--shard"));

@@ -384,6 +384,24 @@ MatrixFile read_matrix_file(const std::string& path) {
   return parse_matrix(text, path);
 }
 
+std::vector<std::string> matrix_plugins(const MatrixFile& file) {
+  std::vector<std::string> paths;
+  for (const auto& sec : file.sections) {
+    if (sec.kind != "defaults") continue;
+    for (const auto& e : sec.entries) {
+      if (e.key != "plugins") continue;
+      const bool array = e.value.kind == MatrixValue::Kind::kArray;
+      const std::vector<MatrixValue> one{e.value};
+      for (const MatrixValue& v : array ? e.value.items : one) {
+        if (v.kind != MatrixValue::Kind::kString || v.text.empty())
+          throw MatrixError(v.where, "'plugins': each entry is the path of a plugin file, as a string");
+        paths.push_back(v.text);
+      }
+    }
+  }
+  return paths;
+}
+
 // ===========================================================================
 // Expansion
 
@@ -396,7 +414,7 @@ const std::vector<std::string>& known_keys() {
       "name", "problems", "methods", "formulations", "integrators", "step", "tol", "rtol", "atol",
       "t_end", "ref_time", "times", "sample_every", "blowup", "observe_every", "series", "keep_series", "repeats",
       "timeout", "repeat_if_under", "work_precision", "overlay", "optional", "perturb", "max_steps",
-      "external", "external_name"};
+      "external", "external_name", "plugins"};
   return keys;
 }
 
@@ -526,6 +544,8 @@ void check_keys(const MatrixSection& sec) {
         throw MatrixError(e.where, "'" + e.key + "': write " + head + ".NAME or " + head + "." + owner + ".NAME");
       continue;
     }
+    if (sec.kind != "defaults" && e.key == "plugins")
+      throw MatrixError(e.where, "'plugins' belongs in [defaults]: a file's plugins load before any sweep");
     if (sec.kind == "defaults" && e.key == "name")
       throw MatrixError(e.where, "'name' belongs in a [[sweep]], not in [defaults]");
     const auto& known = known_keys();

@@ -95,6 +95,9 @@ struct MatrixFile {
 // date, a nested array, inf/nan, a key part that is not a bare key).
 MatrixFile parse_matrix(const std::string& text, const std::string& file_name);
 MatrixFile read_matrix_file(const std::string& path);  // throws UsageError if unreadable
+// The [defaults] `plugins` key's paths, as written (a string or an array of
+// strings); MatrixError for anything else. Loaded before the file expands.
+std::vector<std::string> matrix_plugins(const MatrixFile& file);
 
 // ---------------------------------------------------------------------------
 // Expansion

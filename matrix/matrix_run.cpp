@@ -31,6 +31,9 @@
 #include "matrix/matrix.hpp"
 #include "matrix/provenance.hpp"
 #include "matrix/results.hpp"
+#include "methods/pair.hpp"
+#include "plugin/loader.hpp"
+#include "problems/registry.hpp"
 
 namespace cstab {
 
@@ -47,8 +50,15 @@ constexpr int kExitOk = 0, kExitDiverged = 10, kExitFailed = 11, kExitInvalid = 
 
 std::string case_folder(const std::string& out, const std::string& id) { return out + "/cases/" + id; }
 
+// A case of a plugin's method or problem is also keyed by the plugin's
+// content: the same file gives cached results, a rebuilt one does not.
 std::string cache_key(const MatrixCase& c, const std::string& binary_id) {
-  return c.config_text + "binary=" + binary_id + "\n";
+  std::string key = c.config_text + "binary=" + binary_id + "\n";
+  const std::string method_plugin = origin_identity(method_origin(c.config.method));
+  const std::string problem_plugin = origin_identity(problem_origin(c.config.problem));
+  if (!method_plugin.empty()) key += "method_plugin=" + method_plugin + "\n";
+  if (!problem_plugin.empty()) key += "problem_plugin=" + problem_plugin + "\n";
+  return key;
 }
 
 bool file_equals(const std::string& path, const std::string& content) {

@@ -14,6 +14,7 @@
 
 #include "io/hash.hpp"
 #include "matrix/matrix.hpp"
+#include "plugin/loader.hpp"
 
 #ifndef CSTAB_SOURCE_ROOT
 #define CSTAB_SOURCE_ROOT ""
@@ -123,6 +124,16 @@ Provenance collect_provenance() {
   p.emplace_back("gnuplot", gp.empty() ? "not found" : gp);
   p.emplace_back("binary", self_path());
   p.emplace_back("binary_identity", binary_identity());
+  // Each loaded plugin (plugin/loader.hpp): its path, content identity and
+  // what it added.
+  std::string plugins;
+  for (const auto& pl : loaded_plugins()) {
+    std::string names;
+    for (const auto& m : pl.methods) names += (names.empty() ? "method " : ", method ") + m;
+    for (const auto& q : pl.problems) names += (names.empty() ? "problem " : ", problem ") + q;
+    plugins += (plugins.empty() ? "" : "; ") + pl.path + " (" + pl.identity + ": " + names + ")";
+  }
+  p.emplace_back("plugins", plugins.empty() ? "none" : plugins);
   return p;
 }
 

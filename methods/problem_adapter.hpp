@@ -10,6 +10,7 @@
 #include <memory>
 #include <stdexcept>
 #include <string>
+#include <typeinfo>
 #include <utility>
 #include <vector>
 
@@ -100,7 +101,17 @@ class ProblemAdapter final : public Problem {
   const P& concrete() const { return p_; }
 
  private:
-  const PairOps& pair(const std::string& method) const { return pairs_.at(method_index(method)); }
+  // The built-in pairs by method index; a plugin's method after them, by
+  // this class's type name (the key its plugin registered the pair under).
+  const PairOps& pair(const std::string& method) const {
+    const int i = method_index(method);
+    if (size_t(i) < pairs_.size()) return pairs_[size_t(i)];
+    if (const PairOps* ops = plugin_pair(typeid(P).name(), i)) return *ops;
+    static const PairOps not_built{
+        [](const void*) { return std::string("its plugin was not built for this problem's class"); }, nullptr,
+        nullptr};
+    return not_built;
+  }
   void check_applies(const std::string& method) const {
     const std::string why = why_not(method);
     if (!why.empty()) throw UsageError("--method " + method + ": does not apply to problem '" +

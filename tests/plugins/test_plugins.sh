@@ -1,0 +1,173 @@
+#!/usr/bin/env bash
+# Plugins end to end (issue 21): `cmake --install` of the build under test,
+# the examples built against the installed package, and what a user sees.
+# Usage: test_plugins.sh BUILD_DIR SOURCE_DIR. Exit 0 only if every check holds.
+set -uo pipefail
+build=$1
+src=$2
+work=$(mktemp -d /tmp/cstab-plugins.XXXXXX)
+trap 'rm -rf "$work"' EXIT
+failures=0
+fail() { echo "FAIL: $*"; failures=$((failures + 1)); }
+pass() { echo "ok: $*"; }
+# A number from a `cstab run` line: field NAME followed by its value.
+field() { sed -n "s/.*$1 \([-0-9.e+]*\).*/\1/p" <<<"$2" | head -1; }
+# awk's comparison of two numbers: lt A B is true if A < B.
+lt() { awk -v a="$1" -v b="$2" 'BEGIN { exit !(a + 0 < b + 0) }'; }
+
+prefix=$work/prefix
+cmake --install "$build" --prefix "$prefix" >/dev/null || { echo "FAIL: cmake --install"; exit 1; }
+C=$prefix/bin/cstab
+[[ -x $C ]] || { echo "FAIL: no installed cstab"; exit 1; }
+
+# --- the examples, built against the installed package only
+for ex in velocity_projection double_pendulum; do
+  start=$(date +%s.%N)
+  if ! { cmake -S "$src/examples/$ex" -B "$work/$ex" -DCMAKE_PREFIX_PATH="$prefix" >"$work/$ex.log" 2>&1 &&
+         cmake --build "$work/$ex" -j"$(nproc)" >>"$work/$ex.log" 2>&1; }; then
+    tail -30 "$work/$ex.log"
+    echo "FAIL: building examples/$ex against the installed package"
+    exit 1
+  fi
+  echo "built examples/$ex in $(awk -v a="$start" -v b="$(date +%s.%N)" 'BEGIN { printf "%.1f", b - a }') s"
+done
+VP=$work/velocity_projection/velocity_projection.so
+DP=$work/double_pendulum/double_pendulum.so
+P=(--plugin "$VP" --plugin "$DP")
+
+# --- cstab list says where each came from
+list=$("$C" list "${P[@]}")
+grep -q "^  velocity-projection: " <<<"$list" && grep -q "from plugin $VP" <<<"$list" &&
+  pass "list: velocity-projection from $VP" || fail "list does not show velocity-projection's plugin"
+grep -q "^  double-pendulum: " <<<"$list" && grep -q "from plugin $DP" <<<"$list" &&
+  pass "list: double-pendulum from $DP" || fail "list does not show double-pendulum's plugin"
+CSTAB_PLUGIN_PATH="$VP:$DP" "$C" list | grep -q "from plugin $DP" &&
+  pass "CSTAB_PLUGIN_PATH loads plugins" || fail "CSTAB_PLUGIN_PATH"
+
+# --- the plugin problem against its independent reference (the rod angles'
+# ODE): the Cartesian model integrated tightly agrees with it at t = 5.
+out=$("$C" run "${P[@]}" --problem double-pendulum --method projection --integrator rk8pd --rtol 1e-10 \
+      --atol 1e-10 --t-end ref --out "$work/dp" 2>&1)
+err=$(field "error at t=5" "$out"); de=$(field "max |dE|" "$out"); res=$(field "max residual" "$out")
+echo "double-pendulum / projection / rk8pd 1e-10: error $err, max |dE| $de, max residual $res"
+[[ -n $err ]] && lt "$err" 1e-9 && lt "$de" 1e-8 && lt "$res" 1e-10 &&
+  pass "double-pendulum agrees with its angle-form reference" || fail "double-pendulum reference: $out"
+
+# --- the plugin method against the built-ins on a built-in problem: velocity
+# projection removes the velocity drift that feeds `none`'s quadratic
+# position drift, and is itself above `projection` (positions not projected).
+declare -A r
+for m in none velocity-projection projection; do
+  out=$("$C" run "${P[@]}" --problem pendulum --method $m --integrator rk4 --step 1e-2 --t-end 50 \
+        --out "$work/pend-$m" 2>&1)
+  r[$m]=$(field "max residual" "$out")
+  echo "pendulum / $m / rk4 h = 1e-2, t = 50: max residual ${r[$m]}"
+done
+lt "${r[velocity-projection]}" "$(awk -v a="${r[none]}" 'BEGIN { print a / 10 }')" &&
+  lt "${r[projection]}" "${r[velocity-projection]}" &&
+  pass "residual ordering projection < velocity-projection < none / 10" || fail "residual ordering"
+
+# A plugin method on a plugin problem: neither was built for the other.
+"$C" run "${P[@]}" --problem double-pendulum --method velocity-projection --integrator rk4 --step 1e-3 \
+  --t-end 1 --out "$work/cross" 2>"$work/cross.err"
+rc=$?
+[[ $rc == 2 && ! -e $work/cross ]] && grep -q "not built for this problem" "$work/cross.err" &&
+  pass "a plugin method on a plugin problem: refused, exit 2" || fail "cross plugin: rc $rc $(cat "$work/cross.err")"
+
+# --- a matrix with plugins: cached while the plugin is the same file, rerun
+# when it is rebuilt with other code (only its cases).
+cp "$VP" "$work/vp.so"
+cp "$DP" "$work/dp.so"
+cat >"$work/m.toml" <<'TOML'
+[defaults]
+plugins = ["vp.so", "dp.so"]
+t_end = 5
+integrators = ["rk4"]
+step = [1e-2, 1e-3]
+
+[[sweep]]
+name = "plugin-problem"
+problems = ["double-pendulum"]
+methods = ["projection", "baumgarte"]
+
+[[sweep]]
+name = "plugin-method"
+problems = ["pendulum"]
+methods = ["velocity-projection", "none"]
+TOML
+summary() { grep -o "[0-9]* run, [0-9]* cached" <<<"$1" | head -1; }
+s1=$(summary "$("$C" matrix "$work/m.toml" --out "$work/mr" --jobs 2 --no-report 2>&1)")
+s2=$(summary "$("$C" matrix "$work/m.toml" --out "$work/mr" --jobs 2 --no-report 2>&1)")
+echo "matrix: first '$s1', again '$s2'"
+[[ $s1 == "8 run, 0 cached" && $s2 == "0 run, 8 cached" ]] && pass "matrix with plugins: cached on rerun" ||
+  fail "matrix caching: '$s1' then '$s2'"
+grep -q "^plugins: .*vp.so (.*method velocity-projection)" "$work/mr/provenance.txt" &&
+  grep -q "dp.so (.*problem double-pendulum)" "$work/mr/provenance.txt" &&
+  pass "provenance records each plugin" || fail "provenance: $(grep plugins "$work/mr/provenance.txt")"
+# The method rebuilt with other code (its description changed).
+cp -r "$src/examples/velocity_projection" "$work/vp2-src"
+sed -i 's/(example plugin)/(example plugin, rebuilt)/' "$work/vp2-src/velocity_projection.hpp"
+cmake -S "$work/vp2-src" -B "$work/vp2" -DCMAKE_PREFIX_PATH="$prefix" >/dev/null 2>&1 &&
+  cmake --build "$work/vp2" -j"$(nproc)" >/dev/null 2>&1 || fail "rebuilding velocity_projection"
+cp "$work/vp2/velocity_projection.so" "$work/vp.so"
+s3=$(summary "$("$C" matrix "$work/m.toml" --out "$work/mr" --jobs 2 --no-report 2>&1)")
+echo "matrix after the rebuilt plugin: '$s3'"
+[[ $s3 == "2 run, 6 cached" ]] && pass "a rebuilt plugin reruns its cases only" || fail "rebuilt plugin: '$s3'"
+
+# --- bad plugins: one line naming the file and the reason, exit 2, nothing written
+inc=(-I"$prefix/include/cstab" -I/usr/include/eigen3)
+bad_so() {  # bad_so NAME SOURCE: a shared object from SOURCE
+  printf '%s\n' "$2" >"$work/$1.cpp"
+  c++ -std=c++20 -shared -fPIC "${inc[@]}" "$work/$1.cpp" -o "$work/$1.so" || fail "compiling $1"
+}
+entry='#include "plugin/api.hpp"
+extern "C" const char* cstab_plugin_build_id(void) { return CSTAB_BUILD_ID; }'
+bad_so abi "$entry
+extern \"C\" int cstab_plugin_abi(void) { return CSTAB_PLUGIN_ABI + 1; }
+extern \"C\" void cstab_plugin_register(cstab::PluginRegistrar*) {}"
+bad_so build_id '#include "plugin/api.hpp"
+extern "C" const char* cstab_plugin_build_id(void) { return "0.0.1-0123456789abcdef"; }
+extern "C" int cstab_plugin_abi(void) { return CSTAB_PLUGIN_ABI; }
+extern "C" void cstab_plugin_register(cstab::PluginRegistrar*) {}'
+bad_so clash "$entry
+extern \"C\" int cstab_plugin_abi(void) { return CSTAB_PLUGIN_ABI; }
+extern \"C\" void cstab_plugin_register(cstab::PluginRegistrar* r) {
+  r->add_method(cstab::MethodInfo{\"baumgarte\", \"a second baumgarte\", {}}, {});
+}"
+bad_so missing_symbol "$entry
+extern \"C\" int cstab_plugin_abi(void) { return CSTAB_PLUGIN_ABI; }
+extern \"C\" void cstab_no_such_function_in_cstab(void);
+extern \"C\" void cstab_plugin_register(cstab::PluginRegistrar*) { cstab_no_such_function_in_cstab(); }"
+bad_so empty "$entry
+extern \"C\" int cstab_plugin_abi(void) { return CSTAB_PLUGIN_ABI; }
+extern \"C\" void cstab_plugin_register(cstab::PluginRegistrar*) {}"
+libm=$(ls /lib/*/libm.so.6 /usr/lib/*/libm.so.6 2>/dev/null | head -1)
+check_bad() {  # check_bad WHAT PATH EXPECTED_TEXT
+  local o=$work/out-$1
+  "$C" run --plugin "$2" --problem pendulum --method baumgarte --integrator rk4 --step 1e-3 --t-end 1 \
+    --out "$o" >"$work/$1.stdout" 2>"$work/$1.stderr"
+  local rc=$? lines
+  lines=$(wc -l <"$work/$1.stderr")
+  if [[ $rc == 2 && $lines == 1 && ! -e $o ]] && grep -q -- "$3" "$work/$1.stderr"; then
+    pass "$1: $(cat "$work/$1.stderr")"
+  else
+    fail "$1: exit $rc, $lines lines: $(cat "$work/$1.stderr")"
+  fi
+}
+check_bad missing-file "$work/no-such.so" "plugin $work/no-such.so: no such file"
+check_bad not-a-plugin "$libm" "not a cstab plugin"
+check_bad not-elf "$work/m.toml" "cannot be loaded: invalid ELF header"
+check_bad abi-mismatch "$work/abi.so" "built for plugin ABI"
+check_bad build-id-mismatch "$work/build_id.so" "built against another cstab (build id 0.0.1-0123456789abcdef"
+check_bad name-clash "$work/clash.so" "method 'baumgarte' is already defined (built in)"
+check_bad missing-symbol "$work/missing_symbol.so" "undefined symbol: cstab_no_such_function_in_cstab"
+check_bad registers-nothing "$work/empty.so" "registers no method and no problem"
+# The same method from two files.
+cp "$VP" "$work/vp-copy.so"
+"$C" list --plugin "$VP" --plugin "$work/vp-copy.so" >/dev/null 2>"$work/dup.err"
+rc=$?
+[[ $rc == 2 ]] && grep -q "method 'velocity-projection' is already defined (by $VP)" "$work/dup.err" &&
+  pass "duplicate: $(cat "$work/dup.err")" || fail "duplicate: exit $rc $(cat "$work/dup.err")"
+
+echo "$failures failure(s)"
+exit $((failures > 0))
