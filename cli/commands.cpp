@@ -182,6 +182,9 @@ const std::vector<Command>& commands() {
       {"tune", "Cheapest gain and step/tolerance of a method that reaches a target (harness/tune.hpp)",
        "Writes DIR/tune.csv, DIR/best.csv and, with gnuplot, DIR/tune.png. An unreachable target is a recorded "
        "result (exit 0; best.csv says unreachable).", declare_tune, cmd_tune},
+      {"check", "Conformance checks on what --plugin adds (or on --problem / --method): a pass/fail table",
+       "Exit 1 if any check fails. Checks: applies (why_not), derivatives (per problem), conformance, recovery, "
+       "allocation (docs/plugins.md).", declare_check, cmd_check},
       {"matrix", "Run a benchmark matrix (default: the embedded one; docs/matrix.md)",
        "Exit 128+N if interrupted by signal N (finished cases are kept; run again to resume).", declare_matrix,
        cmd_matrix},

@@ -39,6 +39,10 @@ int cmd_stability(const Args& args);
 // computed elsewhere.
 void declare_score(Args& args);
 int cmd_score(const Args& args);
+// cstab check (check_command.cpp): the conformance checks on plugins' methods
+// and problems, or on chosen ones.
+void declare_check(Args& args);
+int cmd_check(const Args& args);
 // cstab tune (tune_command.cpp): the cheapest gain and step/tolerance for a target.
 void declare_tune(Args& args);
 int cmd_tune(const Args& args);

@@ -45,6 +45,10 @@ t slider_crank 't,q,x,p,qdot,xdot,pdot\n0,0,0,0,0,0,0\n0.1,0,0,0,0,0,0\n'
 t wall_nan '# wall_seconds = nan\nt,x,y,xdot,ydot\n0,1,0,0,0\n0.1,1,0,0,0\n'
 printf 'not gzip' > $M/traj_corrupt.csv.gz
 w() { printf '%b' "$2" > $M/$1.toml; }
+w plugins_in_sweep '[defaults]\nproblems = ["pendulum"]\nmethods = ["none"]\nintegrators = ["rk4"]\nstep = 1e-2\nt_end = 0.1\n[[sweep]]\nname = "a"\nplugins = ["x.so"]\n'
+w plugins_not_string '[defaults]\nplugins = [1]\nproblems = ["pendulum"]\nmethods = ["none"]\nintegrators = ["rk4"]\nstep = 1e-2\nt_end = 0.1\n[[sweep]]\nname = "a"\n'
+w plugins_missing '[defaults]\nplugins = ["no-such.so"]\nproblems = ["pendulum"]\nmethods = ["none"]\nintegrators = ["rk4"]\nstep = 1e-2\nt_end = 0.1\n[[sweep]]\nname = "a"\n'
+
 w good '[[sweep]]\nproblems = ["wheel"]\nmethods = ["pesterev"]\nintegrators = "rk4"\nstep = 1e-3\nt_end = 0.05\n'
 w unknown_key '[[sweep]]\nproblems = ["wheel"]\nmethods = ["pesterev"]\nintegrators = "rk4"\nstep = 1e-3\nt_end = 0.05\nstpe = 1\n'
 w wrong_type '[[sweep]]\nproblems = ["wheel"]\nmethods = ["pesterev"]\nintegrators = "rk4"\nstep = "fast"\nt_end = 0.05\n'
@@ -195,6 +199,14 @@ cases=(
 "tune_tols_for_rk4|tune $T --tols 1e-6 --out OUT"
 "tune_measure_unknown|tune $T --measure speed --out OUT"
 "tune_out_file|tune $T --out /etc/passwd"
+"plugin_missing|run $G --plugin /nonexistent.so --out OUT"
+"plugin_not_elf|run $G --plugin /etc/passwd --out OUT"
+"plugin_not_plugin|run $G --plugin $(ls /lib/*/libm.so.6 /usr/lib/*/libm.so.6 2>/dev/null | head -1) --out OUT"
+"plugin_no_value|list --plugin"
+"plugin_empty|run $G --plugin= --out OUT"
+"check_nothing|check"
+"check_unknown_problem|check --problem nope"
+"check_unknown_method|check --method nope"
 "mat_missing_file|matrix /nonexistent.toml --out OUT"
 "mat_folder_as_file|matrix /tmp --out OUT"
 "mat_two_files|matrix $M/good.toml $M/good.toml --out OUT"

@@ -10,6 +10,7 @@
 #include <tuple>
 #include <vector>
 
+#include "harness/conformance.hpp"
 #include "harness/integrator.hpp"
 #include "harness/run.hpp"
 #include "methods/pair.hpp"
@@ -29,48 +30,11 @@ std::vector<Combo> combinations(bool applicable) {
   return out;
 }
 
-// How each method is run in the conformance suite: the settings it declares
-// (ConformanceSettings, core/problem.hpp), within the problem's resolution step.
-// `accuracy`: the run's accuracy is checked (a consistent start).
-RunConfig config_for(const Problem& problem, const MethodInfo& method, double t_end, bool accuracy) {
-  const ConformanceSettings& c = method.conformance;
-  RunConfig cfg;
-  cfg.problem = problem.info().name;
-  cfg.method = method.name;
-  cfg.t_end = t_end;
-  cfg.ref_time = t_end;
-  cfg.write_series = false;
-  cfg.integrator = c.integrator;
-  cfg.params = c.params;
-  if (find_integrator(c.integrator).fixed_step) {
-    cfg.step.step = std::min(c.step, t_end / 2000);
-    if (problem.info().resolution_step > 0) cfg.step.step = std::min(cfg.step.step, problem.info().resolution_step);
-    if (accuracy && c.accuracy_steps > 0) cfg.step.step = std::min(cfg.step.step, t_end / c.accuracy_steps);
-  } else {
-    cfg.step.rtol = cfg.step.atol = c.tol;
-  }
-  if (c.time_scale_steps > 0) {
-    const ParamSpec* gain = find_gain(method.params);
-    if (!gain || gain->role != ParamRole::kTimeScale) {
-      ADD_FAILURE() << method.name << ": time_scale_steps needs a time-scale gain";
-      return cfg;
-    }
-    cfg.params.emplace_back(gain->name, std::to_string(c.time_scale_steps * cfg.step.step));
-  }
-  return cfg;
-}
-
 const MethodInfo& method_named(const std::string& name) { return all_methods().at(method_index(name)); }
 
-double initial_residual(const Problem& problem, const RunConfig& cfg) {
-  const auto specs = problem.method_params(cfg.method, cfg.formulation);
-  auto form = problem.make(cfg.method, cfg.formulation, Params::resolve(specs, cfg.params, cfg.method));
-  std::vector<double> y(form->dimension()), r(form->constraints().size());
-  form->initial_state(y.data());
-  form->residuals(0.0, y.data(), r.data());
-  double worst = 0;
-  for (double v : r) worst = std::max(worst, std::abs(v));
-  return worst;
+// The suite's settings (harness/conformance.hpp, shared with `cstab check`).
+RunConfig config_for(const Problem& problem, const MethodInfo& method, double t_end, bool accuracy) {
+  return conformance_config(problem, method, t_end, accuracy);
 }
 
 // Pairs the suite found short of the method's accuracy promise: the bound
@@ -160,6 +124,22 @@ std::string combo_name(const ::testing::TestParamInfo<Combo>& info) {
 }
 
 INSTANTIATE_TEST_SUITE_P(AllProblemsAllMethods, Conformance, ::testing::ValuesIn(combinations(true)), combo_name);
+
+// The model's derivative chain (AD, or its closed forms) against its
+// constraint functions, by central differences along the flow of `none`
+// (harness/conformance.hpp; `cstab check` holds plugins to the same bound).
+TEST(DerivativeConsistency, EveryModelsJacobiansAndGammaMatchItsConstraints) {
+  for (const auto& p : all_problems()) {
+    std::string detail;
+    const double worst = derivative_consistency(*p, &detail);
+    if (!p->why_not("none").empty()) {
+      EXPECT_TRUE(std::isnan(worst)) << p->info().name;
+      continue;
+    }
+    EXPECT_LT(worst, 1e-5) << p->info().name << ": " << detail;
+    EXPECT_GT(worst, 0.0) << p->info().name << ": a difference of exactly zero: is anything evaluated?";
+  }
+}
 
 // A method that does not apply (e.g. "minimal" on a problem without a
 // minimal-coordinate model) names its reason and refuses to build.

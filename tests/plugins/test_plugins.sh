@@ -114,6 +114,41 @@ s3=$(summary "$("$C" matrix "$work/m.toml" --out "$work/mr" --jobs 2 --no-report
 echo "matrix after the rebuilt plugin: '$s3'"
 [[ $s3 == "2 run, 6 cached" ]] && pass "a rebuilt plugin reruns its cases only" || fail "rebuilt plugin: '$s3'"
 
+# --- cstab check: the examples pass every check; three deliberately wrong
+# plugins fail, each for its reason (tests/plugins/bad_*).
+for so in "$VP" "$DP"; do
+  "$C" check --plugin "$so" >"$work/check.out" 2>&1
+  rc=$?
+  [[ $rc == 0 ]] && grep -q ", 0 FAIL$" "$work/check.out" && pass "check $(basename "$so"): $(tail -1 "$work/check.out")" ||
+    { cat "$work/check.out"; fail "check $(basename "$so"): exit $rc"; }
+done
+for b in bad_jacobian bad_methods; do
+  cmake -S "$src/tests/plugins/$b" -B "$work/$b" -DCMAKE_PREFIX_PATH="$prefix" >"$work/$b.log" 2>&1 &&
+    cmake --build "$work/$b" -j"$(nproc)" >>"$work/$b.log" 2>&1 || { tail -20 "$work/$b.log"; fail "building $b"; }
+done
+expect_check() {  # expect_check SO ROW_REGEX WHAT: exit 1 and a FAIL row matching ROW_REGEX
+  "$C" check --plugin "$1" >"$work/check.out" 2>&1
+  local rc=$?
+  if [[ $rc == 1 ]] && grep -Eq "$2" "$work/check.out"; then
+    pass "check catches $3: $(grep -E "$2" "$work/check.out" | head -1 | tr -s ' ')"
+  else
+    cat "$work/check.out"
+    fail "check did not catch $3 (exit $rc)"
+  fi
+}
+expect_check "$work/bad_jacobian/bad_jacobian.so" "^wrong-jacobian +none +derivatives +FAIL +d2/dt2 length" \
+  "a wrong closed-form Jacobian"
+expect_check "$work/bad_methods/allocating_none.so" "^pendulum +allocating-none +allocation +FAIL +[1-9][0-9]* heap allocations" \
+  "an allocating step"
+grep -Eq "^pendulum +allocating-none +conformance +pass" "$work/check.out" &&
+  pass "the allocating method fails only its allocation check" || fail "allocating-none: conformance should pass"
+expect_check "$work/bad_methods/ignores_constraints.so" \
+  "^pendulum +ignores-constraints +conformance +FAIL +rk8pd tol 1e-10; final residual [0-9.e+]+ >= 1e-06" \
+  "a method that ignores the constraint"
+"$C" check >/dev/null 2>"$work/check.err"
+[[ $? == 2 ]] && grep -q "nothing to check" "$work/check.err" && pass "check without a plugin: exit 2" ||
+  fail "check without a plugin: $(cat "$work/check.err")"
+
 # --- bad plugins: one line naming the file and the reason, exit 2, nothing written
 inc=(-I"$prefix/include/cstab" -I/usr/include/eigen3)
 bad_so() {  # bad_so NAME SOURCE: a shared object from SOURCE

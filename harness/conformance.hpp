@@ -1,0 +1,32 @@
+// How the conformance checks run a method on a problem (the GoogleTest
+// suite tests/conformance/ and `cstab check`): the settings the method
+// declares (ConformanceSettings, core/problem.hpp) within the problem's
+// resolution step, and the derivative check of a model through `none`.
+#pragma once
+
+#include <string>
+
+#include "harness/run.hpp"
+
+namespace cstab {
+
+// The run of `method` on `problem` to t_end with the method's declared
+// integrator, step or tolerance and parameters; `accuracy`: the run's
+// accuracy is checked (a consistent start), so the method's accuracy_steps
+// apply. Throws std::logic_error if the settings name a time-scale gain the
+// method does not declare.
+RunConfig conformance_config(const Problem& problem, const MethodInfo& method, double t_end, bool accuracy);
+
+// The largest |residual| of the method's formulation at its initial state.
+double initial_residual(const Problem& problem, const RunConfig& config);
+
+// The model's derivative chain against its constraint functions, through
+// the index-1 formulation of `none` (which makes Phi'' = 0 on holonomic
+// rows and Psi' = 0 on the others with the model's Jacobians and gamma, AD
+// or closed forms): along the flow y(s) = y + s f + s^2/2 f', the residual's
+// second (holonomic) or first (other rows) central difference, relative to
+// 1 + |f| + |f'|, at the initial state and at a perturbed one. Returns the
+// worst; `detail` says where. NaN (and why in detail) if `none` does not apply.
+double derivative_consistency(const Problem& problem, std::string* detail);
+
+}  // namespace cstab
