@@ -16,10 +16,10 @@
 #include <set>
 #include <sstream>
 
-#include "cli/alloc_count.hpp"
 #include "cli/args.hpp"
 #include "cli/commands.hpp"
 #include "core/format.hpp"
+#include "harness/alloc_count.hpp"
 #include "harness/conformance.hpp"
 #include "harness/integrator.hpp"
 #include "methods/pair.hpp"
@@ -66,17 +66,11 @@ void check_derivatives(const Problem& p, std::vector<Row>& rows) {
 
 void check_conformance(const Problem& p, const MethodInfo& m, std::vector<Row>& rows) {
   const ConformanceSettings& promise = m.conformance;
-  const double t_end = std::min(2.0, p.info().default_t_end);
-  RunConfig probe = conformance_config(p, m, t_end, false);
-  if (p.why_not("none").empty()) {
-    probe.method = "none";
-    probe.params.clear();
-    probe.formulation.clear();
-  }
-  const double r0 = initial_residual(p, probe);
-  const bool consistent = r0 < 1e-10;
-  const RunConfig cfg = conformance_config(p, m, t_end, consistent);
-  const RunResult r = run_case(p, cfg, "");
+  const ConformanceRun run = run_conformance(p, m);
+  const double t_end = run.t_end, r0 = run.start_residual;
+  const bool consistent = run.consistent_start;
+  const RunConfig& cfg = run.config;
+  const RunResult& r = run.result;
   std::vector<std::string> failed, seen;
   auto bound = [&](const std::string& what, double value, double limit) {
     seen.push_back(what + " " + g3(value) + (value < limit ? " < " : " >= ") + g3(limit));
@@ -124,47 +118,23 @@ void check_recovery(const Problem& p, const MethodInfo& m, std::vector<Row>& row
 }
 
 void check_allocation(const Problem& p, const MethodInfo& m, std::vector<Row>& rows) {
-  if (!counting_available()) {
-    rows.push_back({p.info().name, m.name, "allocation", "n/a", "not counted in a sanitized build"});
-    return;
-  }
   const double t_end = std::min(2.0, p.info().default_t_end);
   const RunConfig cfg = conformance_config(p, m, t_end, false);
-  const IntegratorInfo& info = find_integrator(cfg.integrator);
   auto form = p.make(m.name, cfg.formulation,
                      Params::resolve(p.method_params(m.name, cfg.formulation), cfg.params, m.name));
-  form->set_step_hint(info.fixed_step ? cfg.step.step : 0.0);
-  auto integ = make_integrator(cfg.integrator, cfg.step);
-  std::vector<double> y0(form->dimension());
-  form->initial_state(y0.data());
-  integ->start(*form, 0.0, y0.data());
-  auto one_step = [&]() {
-    if (integ->step(1e300) != StepOutcome::kOk) return false;
-    if (form->has_post_step() && !integ->applies_post_step() && form->post_step(integ->t(), integ->y()))
-      return integ->notify_modified();
-    return true;
-  };
   constexpr int kWarmup = 20, kSteps = 200;
-  for (int i = 0; i < kWarmup; ++i)
-    if (!one_step()) {
-      rows.push_back({p.info().name, m.name, "allocation", "FAIL", "a warm-up step failed: " + integ->failure_reason()});
-      return;
-    }
-  long allocations = 0;
-  int taken = 0;
-  {
-    AllocationWindow w;
-    for (; taken < kSteps; ++taken)
-      if (!one_step()) break;
-    allocations = w.count();
+  const StepAllocations a = count_step_allocations(*form, cfg.integrator, cfg.step, kWarmup, kSteps);
+  Row row{p.info().name, m.name, "allocation", "FAIL", ""};
+  if (a.warmup_failed) {
+    row.detail = "a warm-up step failed: " + a.failure;
+  } else if (a.taken < kSteps) {
+    row.detail = "step " + std::to_string(a.taken) + " failed (" + a.failure + ")";
+  } else {
+    row.result = a.allocations == 0 ? "pass" : "FAIL";
+    row.detail = std::to_string(a.allocations) + " heap allocations in " + cfg.integrator + ", " +
+                 std::to_string(a.taken) + " steps";
   }
-  const std::string where = cfg.integrator + ", " + std::to_string(taken) + " steps";
-  if (taken < kSteps)
-    rows.push_back({p.info().name, m.name, "allocation", "FAIL", "step " + std::to_string(taken) + " failed (" +
-                                                                      integ->failure_reason() + ")"});
-  else
-    rows.push_back({p.info().name, m.name, "allocation", allocations == 0 ? "pass" : "FAIL",
-                    std::to_string(allocations) + " heap allocations in " + where});
+  rows.push_back(row);
 }
 
 std::string pad(const std::string& s, size_t width) { return s.size() >= width ? s + " " : s + std::string(width - s.size(), ' '); }

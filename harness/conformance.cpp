@@ -48,6 +48,22 @@ double initial_residual(const Problem& problem, const RunConfig& cfg) {
   return worst;
 }
 
+ConformanceRun run_conformance(const Problem& problem, const MethodInfo& method) {
+  ConformanceRun c;
+  c.t_end = std::min(2.0, problem.info().default_t_end);
+  RunConfig probe = conformance_config(problem, method, c.t_end, false);
+  if (problem.why_not("none").empty()) {
+    probe.method = "none";
+    probe.params.clear();
+    probe.formulation.clear();
+  }
+  c.start_residual = initial_residual(problem, probe);
+  c.consistent_start = c.start_residual < 1e-10;
+  c.config = conformance_config(problem, method, c.t_end, c.consistent_start);
+  c.result = run_case(problem, c.config, "");
+  return c;
+}
+
 double derivative_consistency(const Problem& problem, std::string* detail) {
   const std::string why = problem.why_not("none");
   if (!why.empty()) {

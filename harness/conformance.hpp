@@ -17,6 +17,19 @@ namespace cstab {
 // method does not declare.
 RunConfig conformance_config(const Problem& problem, const MethodInfo& method, double t_end, bool accuracy);
 
+// The conformance run of `method` on `problem` over [0, min(2, the
+// problem's horizon)]: whether the problem's own start is consistent (asked
+// of `none` where it applies, since DAE methods move an inconsistent start
+// onto the manifold first), then the run with accuracy settings if it is.
+struct ConformanceRun {
+  double t_end = 0;
+  double start_residual = 0;  // largest |residual| at t = 0
+  bool consistent_start = false;
+  RunConfig config;
+  RunResult result;
+};
+ConformanceRun run_conformance(const Problem& problem, const MethodInfo& method);
+
 // The largest |residual| of the method's formulation at its initial state.
 double initial_residual(const Problem& problem, const RunConfig& config);
 

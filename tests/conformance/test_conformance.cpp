@@ -32,11 +32,6 @@ std::vector<Combo> combinations(bool applicable) {
 
 const MethodInfo& method_named(const std::string& name) { return all_methods().at(method_index(name)); }
 
-// The suite's settings (harness/conformance.hpp, shared with `cstab check`).
-RunConfig config_for(const Problem& problem, const MethodInfo& method, double t_end, bool accuracy) {
-  return conformance_config(problem, method, t_end, accuracy);
-}
-
 // Pairs the suite found short of the method's accuracy promise: the bound
 // each meets instead and why. A finding, not a tolerance: fix the method and
 // remove the row (the test fails once the pair meets the promise again).
@@ -64,21 +59,12 @@ TEST_P(Conformance, StaysOnManifoldAndMatchesReference) {
   const auto& [problem_name, method] = GetParam();
   const Problem& problem = find_problem(problem_name);
   ASSERT_EQ(problem.why_not(method), "");
-  const double t_end = std::min(2.0, problem.info().default_t_end);
   const MethodInfo& info = method_named(method);
   const ConformanceSettings& promise = info.conformance;
-  // Whether the problem's own initial data are consistent (the DAE methods
-  // move inconsistent data onto the manifold first, so ask `none` where it applies).
-  RunConfig probe = config_for(problem, info, t_end, false);
-  if (problem.why_not("none").empty()) {
-    probe.method = "none";
-    probe.params.clear();
-    probe.formulation.clear();
-  }
-  const double r0 = initial_residual(problem, probe);
-  const bool consistent_start = r0 < 1e-10;
-  const RunConfig cfg = config_for(problem, info, t_end, consistent_start);
-  const RunResult r = run_case(problem, cfg, "");
+  const ConformanceRun run = run_conformance(problem, info);
+  const double t_end = run.t_end, r0 = run.start_residual;
+  const bool consistent_start = run.consistent_start;
+  const RunResult& r = run.result;
   ASSERT_EQ(r.status, "ok") << r.reason;
   EXPECT_DOUBLE_EQ(r.t_reached, t_end);
 

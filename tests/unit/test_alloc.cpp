@@ -1,6 +1,6 @@
-// No heap allocation per step. This binary replaces the global operator
-// new/delete with counting versions; a counter armed around a window of
-// steps must stay at zero:
+// No heap allocation per step. This binary counts operator new calls
+// (harness/alloc_count.hpp, the counter `cstab check` uses); a counter
+// armed around a window of steps must stay at zero:
 //  * StepLoop: every problem x method (ODE and DAE) x integrator, stepping
 //    the integrator directly (with the method's post-step hook), after a
 //    warm-up;
@@ -9,64 +9,18 @@
 //    the same number of times over N and over 4N steps, so nothing per step.
 #include <gtest/gtest.h>
 
-#include <atomic>
-#include <cstdlib>
-#include <new>
 #include <ostream>
 #include <string>
 #include <vector>
 
+#include "harness/alloc_count.hpp"
 #include "harness/integrator.hpp"
 #include "harness/run.hpp"
 #include "methods/pair.hpp"
 #include "problems/registry.hpp"
 
-namespace {
-std::atomic<bool> g_armed{false};
-std::atomic<long> g_allocations{0};
-
-void* counted_alloc(std::size_t n) {
-  if (g_armed.load(std::memory_order_relaxed)) g_allocations.fetch_add(1, std::memory_order_relaxed);
-  if (void* p = std::malloc(n == 0 ? 1 : n)) return p;
-  throw std::bad_alloc();
-}
-void* counted_alloc_aligned(std::size_t n, std::align_val_t al) {
-  if (g_armed.load(std::memory_order_relaxed)) g_allocations.fetch_add(1, std::memory_order_relaxed);
-  const std::size_t a = static_cast<std::size_t>(al);
-  if (void* p = std::aligned_alloc(a, (n + a - 1) / a * a)) return p;
-  throw std::bad_alloc();
-}
-}  // namespace
-
-void* operator new(std::size_t n) { return counted_alloc(n); }
-void* operator new[](std::size_t n) { return counted_alloc(n); }
-void* operator new(std::size_t n, const std::nothrow_t&) noexcept {
-  try { return counted_alloc(n); } catch (...) { return nullptr; }
-}
-void* operator new[](std::size_t n, const std::nothrow_t&) noexcept {
-  try { return counted_alloc(n); } catch (...) { return nullptr; }
-}
-void* operator new(std::size_t n, std::align_val_t a) { return counted_alloc_aligned(n, a); }
-void* operator new[](std::size_t n, std::align_val_t a) { return counted_alloc_aligned(n, a); }
-void operator delete(void* p) noexcept { std::free(p); }
-void operator delete[](void* p) noexcept { std::free(p); }
-void operator delete(void* p, std::size_t) noexcept { std::free(p); }
-void operator delete[](void* p, std::size_t) noexcept { std::free(p); }
-void operator delete(void* p, std::align_val_t) noexcept { std::free(p); }
-void operator delete[](void* p, std::align_val_t) noexcept { std::free(p); }
-void operator delete(void* p, std::size_t, std::align_val_t) noexcept { std::free(p); }
-void operator delete[](void* p, std::size_t, std::align_val_t) noexcept { std::free(p); }
-
 namespace cstab {
 namespace {
-
-// Counts operator new calls while alive.
-class AllocationWindow {
- public:
-  AllocationWindow() { g_allocations = 0; g_armed = true; }
-  ~AllocationWindow() { g_armed = false; }
-  long count() const { return g_allocations.load(); }
-};
 
 TEST(AllocationCounter, CountsAllocations) {
   // The counter itself must see an allocation, or every zero below is vacuous.
@@ -166,30 +120,11 @@ TEST_P(StepLoop, NoAllocationPerStep) {
   const IntegratorInfo& info = find_integrator(c.integrator);
   const StepSettings s = settings_for(p, info);
   auto form = p.make(c.method, c.formulation, Params::resolve(specs, params_for(c, s), c.method));
-  form->set_step_hint(info.fixed_step ? s.step : 0.0);
-  auto integ = make_integrator(c.integrator, s);
-  std::vector<double> y0(form->dimension());
-  form->initial_state(y0.data());
-  integ->start(*form, 0.0, y0.data());
-
-  auto one_step = [&]() {
-    if (integ->step(1e300) != StepOutcome::kOk) return false;
-    if (form->has_post_step() && !integ->applies_post_step() && form->post_step(integ->t(), integ->y()))
-      return integ->notify_modified();
-    return true;
-  };
   constexpr int kWarmup = 20, kSteps = 200;
-  for (int i = 0; i < kWarmup; ++i) ASSERT_TRUE(one_step()) << integ->failure_reason();
-  long allocations = 0;
-  int taken = 0;
-  {
-    AllocationWindow w;
-    for (; taken < kSteps; ++taken)
-      if (!one_step()) break;
-    allocations = w.count();
-  }
-  ASSERT_EQ(taken, kSteps) << "step failed: " << integ->failure_reason();
-  EXPECT_EQ(allocations, 0) << allocations << " allocations in " << kSteps << " steps";
+  const StepAllocations a = count_step_allocations(*form, c.integrator, s, kWarmup, kSteps);
+  ASSERT_FALSE(a.warmup_failed) << a.failure;
+  ASSERT_EQ(a.taken, kSteps) << "step failed: " << a.failure;
+  EXPECT_EQ(a.allocations, 0) << a.allocations << " allocations in " << kSteps << " steps";
 }
 
 std::string case_name(const ::testing::TestParamInfo<Case>& info) {

@@ -1,28 +1,17 @@
-#include "cli/alloc_count.hpp"
+#include "harness/alloc_count.hpp"
 
 #include <atomic>
 #include <cstdlib>
 #include <new>
-
-#if defined(__SANITIZE_ADDRESS__)
-#define CSTAB_COUNT_ALLOCATIONS 0
-#elif defined(__has_feature)
-#if __has_feature(address_sanitizer)
-#define CSTAB_COUNT_ALLOCATIONS 0
-#endif
-#endif
-#ifndef CSTAB_COUNT_ALLOCATIONS
-#define CSTAB_COUNT_ALLOCATIONS 1
-#endif
+#include <vector>
 
 namespace {
 std::atomic<bool> g_armed{false};
 std::atomic<long> g_allocations{0};
 }  // namespace
 
-namespace cstab::cli {
+namespace cstab {
 
-bool counting_available() { return CSTAB_COUNT_ALLOCATIONS != 0; }
 AllocationWindow::AllocationWindow() {
   g_allocations = 0;
   g_armed = true;
@@ -30,9 +19,39 @@ AllocationWindow::AllocationWindow() {
 AllocationWindow::~AllocationWindow() { g_armed = false; }
 long AllocationWindow::count() const { return g_allocations.load(); }
 
-}  // namespace cstab::cli
+StepAllocations count_step_allocations(Formulation& form, const std::string& integrator, const StepSettings& step,
+                                       int warmup, int steps) {
+  const IntegratorInfo& info = find_integrator(integrator);
+  form.set_step_hint(info.fixed_step ? step.step : 0.0);
+  auto integ = make_integrator(integrator, step);
+  std::vector<double> y0(form.dimension());
+  form.initial_state(y0.data());
+  integ->start(form, 0.0, y0.data());
+  auto one_step = [&]() {
+    if (integ->step(1e300) != StepOutcome::kOk) return false;
+    if (form.has_post_step() && !integ->applies_post_step() && form.post_step(integ->t(), integ->y()))
+      return integ->notify_modified();
+    return true;
+  };
+  StepAllocations out;
+  for (int i = 0; i < warmup; ++i)
+    if (!one_step()) {
+      out.warmup_failed = true;
+      out.failure = integ->failure_reason();
+      return out;
+    }
+  {
+    AllocationWindow w;
+    for (; out.taken < steps; ++out.taken)
+      if (!one_step()) break;
+    out.allocations = w.count();
+  }
+  if (out.taken < steps) out.failure = integ->failure_reason();
+  return out;
+}
 
-#if CSTAB_COUNT_ALLOCATIONS
+}  // namespace cstab
+
 namespace {
 void* counted_alloc(std::size_t n) {
   if (g_armed.load(std::memory_order_relaxed)) g_allocations.fetch_add(1, std::memory_order_relaxed);
@@ -73,4 +92,3 @@ void operator delete(void* p, std::align_val_t) noexcept { std::free(p); }
 void operator delete[](void* p, std::align_val_t) noexcept { std::free(p); }
 void operator delete(void* p, std::size_t, std::align_val_t) noexcept { std::free(p); }
 void operator delete[](void* p, std::size_t, std::align_val_t) noexcept { std::free(p); }
-#endif
