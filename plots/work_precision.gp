@@ -16,6 +16,8 @@
 #   5 max |energy or first-integral drift|  6 step size or tolerance
 # "?" marks a value that does not exist (no reference, exact zero on a log axis).
 # lcs, pts, dts: per block, the linetype (colour), point type and dash type.
+# ncstab: the first ncstab blocks are cstab's; the rest are other engines'
+# (external cases), listed in the key under the heading "other engines".
 # has_ref, has_drift = 0: the run has no reference error / no drift; the
 # panel says so instead of plotting.
 # Writes out.png and out.svg; formats = "png"
@@ -36,9 +38,13 @@ if (!exists("pts")) { pts = ""; do for [i=1:n] { pts = pts." 7" } }
 if (!exists("dts")) { dts = ""; do for [i=1:n] { dts = dts." 1" } }
 if (!exists("has_ref")) has_ref = 1
 if (!exists("has_drift")) has_drift = 1
-lc(i) = int(word(lcs, i + 1))
-pt(i) = int(word(pts, i + 1))
-dt(i) = int(word(dts, i + 1))
+if (!exists("ncstab")) ncstab = n
+# The key's heading before the other engines' curves (none without them).
+heading = (ncstab < n) ? 1 : 0
+# (Guarded: gnuplot evaluates a plot's options even for an empty iteration.)
+lc(i) = i < words(lcs) ? int(word(lcs, i + 1)) : 1
+pt(i) = i < words(pts) ? int(word(pts, i + 1)) : 7
+dt(i) = i < words(dts) ? int(word(dts, i + 1)) : 1
 # An empty panel with a message, for a quantity the runs do not have.
 empty_panel(msg) = sprintf("set label 99 '%s' at graph 0.5, 0.5 center noenhanced; unset logscale y; set yrange [0:1]; set ytics format ''; plot -1 notitle; unset label 99; set autoscale y; set ytics format '%%g'", msg)
 
@@ -62,12 +68,16 @@ do for [fmt in formats] {
   set title "error against the reference solution"
   set key at screen 0.815, 0.93 left top font ",10" box opaque samplen 3 spacing 1.15 title "method/integrator" noenhanced
   if (has_ref) {
-    plot for [i=0:n-1] data index i using 1:2 with linespoints lt lc(i) pt pt(i) dt dt(i) title columnheader(1) noenhanced
+    plot for [i=0:ncstab-1] data index i using 1:2 with linespoints lt lc(i) pt pt(i) dt dt(i) title columnheader(1) noenhanced, \
+         for [j=1:heading] keyentry with points pt -1 title "other engines:", \
+         for [i=ncstab:n-1] data index i using 1:2 with linespoints lt lc(i) pt pt(i) dt dt(i) title columnheader(1) noenhanced
   } else {
     # The key still lists the curves: plotted out of range.
     set label 99 "no reference solution within the horizon" at graph 0.5, 0.5 center noenhanced
     set yrange [1:10]
-    plot for [i=0:n-1] data index i using 1:(1e-3) with linespoints lt lc(i) pt pt(i) dt dt(i) title columnheader(1) noenhanced
+    plot for [i=0:ncstab-1] data index i using 1:(1e-3) with linespoints lt lc(i) pt pt(i) dt dt(i) title columnheader(1) noenhanced, \
+         for [j=1:heading] keyentry with points pt -1 title "other engines:", \
+         for [i=ncstab:n-1] data index i using 1:(1e-3) with linespoints lt lc(i) pt pt(i) dt dt(i) title columnheader(1) noenhanced
     set autoscale y
     unset label 99
   }

@@ -9,6 +9,7 @@
 #include <cstdlib>
 #include <ctime>
 #include <filesystem>
+#include <functional>
 #include <iostream>
 #include <limits>
 #include <map>
@@ -504,25 +505,38 @@ struct ProblemStyle {
   }
 };
 
-// Work-precision data: one block per curve, coarse to fine, with its styles.
+// A case of another engine: an external case of a matrix (matrix/external.hpp).
+bool other_engine(const CaseResult& c) { return c.entry->integrator == "external"; }
+
+// The engine of an external curve: its name up to the first '-'
+// ("simbody-rkmerson" -> "simbody"), as matrices/peers.toml names them.
+std::string engine_of(const CaseResult& c) { return c.entry->method.substr(0, c.entry->method.find('-')); }
+
+// Work-precision data: one block per curve, coarse to fine, with its styles;
+// cstab's curves first, then other engines' (external cases), which the
+// picture draws with their own point and dash under the key's "other
+// engines" heading.
 struct WorkPrecisionData {
   std::string text, lcs, pts, dts;
-  size_t blocks = 0;
+  size_t blocks = 0, cstab_blocks = 0;
   bool has_ref = false, has_drift = false;
 };
 WorkPrecisionData work_precision_data(const ProblemView& p, const ProblemStyle& style) {
   WorkPrecisionData d;
+  for (int pass = 0; pass < 2; ++pass)
   for (const auto& curve : p.curves) {
     std::vector<const CaseResult*> pts_of;
     for (const CaseResult* c : p.wp)
-      if (c->entry->curve == curve && timed(*c)) pts_of.push_back(c);
+      if (c->entry->curve == curve && timed(*c) && other_engine(*c) == (pass == 1)) pts_of.push_back(c);
     if (pts_of.empty()) continue;
+    if (pass == 0) ++d.cstab_blocks;
     std::stable_sort(pts_of.begin(), pts_of.end(), [](const CaseResult* a, const CaseResult* b) {
       return a->entry->t_end != b->entry->t_end ? a->entry->t_end < b->entry->t_end : case_size(*a) > case_size(*b);
     });
     if (d.blocks++) d.text += "\n\n";
     d.text += quoted_header(curve, {"wall_median_s", "ref_error", "ref_scd", "max_residual", "max_drift", "setting"});
-    const auto [point, dash] = style.integrator(pts_of[0]->entry->integrator);
+    auto [point, dash] = style.integrator(pts_of[0]->entry->integrator);
+    if (pass == 1) point = 3, dash = 4;  // other engines: asterisks, dash-dot
     d.lcs += " " + std::to_string(style.colour.at(pts_of[0]->entry->method));
     d.pts += " " + std::to_string(point);
     d.dts += " " + std::to_string(dash);
@@ -551,9 +565,11 @@ void add_work_precision_plot(PlotSet& plots, ProblemView& p, const ProblemStyle&
       "; problem=" + gnuplot_string(p.name) + "; has_ref=" + std::string(d.has_ref ? "1" : "0") +
           "; has_drift=" + (d.has_drift ? "1" : "0") + "; drift_label=" + gnuplot_string(drift_label) +
           "; ref_label=" + gnuplot_string(ref_label) + "; lcs=" + gnuplot_string(d.lcs) +
-          "; pts=" + gnuplot_string(d.pts) + "; dts=" + gnuplot_string(d.dts),
+          "; pts=" + gnuplot_string(d.pts) + "; dts=" + gnuplot_string(d.dts) +
+          "; ncstab=" + std::to_string(d.cstab_blocks),
       "Work-precision of " + p.name + ": error against wall time (median of repeats), log-log, one curve "
-      "per method/integrator (colour = method, point and dash = integrator); points from coarse to fine "
+      "per method/integrator (colour = method, point and dash = integrator; other engines, external cases, "
+      "listed under \"other engines\" with asterisks and dash-dot lines); points from coarse to fine "
       "step size or tolerance. Top left: max |y - y_ref| at " + ref_label + "; top right: significant "
       "correct digits; bottom: largest constraint residual and largest " +
           (p.drift_name.empty() ? std::string("drift") : p.drift_name + " drift") +
@@ -815,6 +831,49 @@ void html_figure(std::ostream& h, const PlotSet& plots, const std::string& name)
     << ".</figcaption></figure>\n";
 }
 
+// Per problem with external cases: at each reference-error level, cstab's
+// fastest stabilized method (the constraint-free baselines none and minimal
+// left out) against each other engine's fastest setting, as a wall-time
+// ratio (scripts/peer-table.sh draws the same from work_precision.csv).
+void html_other_engines(std::ostream& h, const ProblemView& p) {
+  std::vector<std::string> engines;
+  for (const CaseResult* c : p.wp)
+    if (other_engine(*c) && std::find(engines.begin(), engines.end(), engine_of(*c)) == engines.end())
+      engines.push_back(engine_of(*c));
+  if (engines.empty()) return;
+  // The fastest case reaching `level` among those `take` accepts.
+  auto fastest = [&](double level, const std::function<bool(const CaseResult&)>& take) {
+    const CaseResult* best = nullptr;
+    for (const CaseResult* c : p.wp)
+      if (timed(*c) && c->ref_error <= level && take(*c) && (!best || c->wall_median < best->wall_median)) best = c;
+    return best;
+  };
+  auto cell = [](const CaseResult* c) {
+    return c ? "<td>" + html_escape(c->entry->curve + " " + case_setting(*c)) + "</td><td class=\"num\">" +
+                   seconds_text(c->wall_median) + "</td>"
+             : std::string("<td>not reached</td><td></td>");
+  };
+  h << "<h3>Other engines</h3>\n<p class=\"meta\">External cases (other engines run as outside programs and "
+       "scored like a run): at each level of error against the reference, cstab's fastest case (none and minimal, "
+       "which do not stabilize, left out) and each engine's fastest setting, with the engine's wall time as a "
+       "multiple of cstab's (above 1: cstab is faster). An engine is an external curve's name up to its first "
+       "'-'.</p>\n<table><tr><th>error &le;</th><th>cstab fastest</th><th>wall</th><th>engine</th>"
+       "<th>engine fastest</th><th>wall</th><th>engine / cstab</th></tr>\n";
+  for (double level : {1e-3, 1e-6, 1e-9}) {
+    const CaseResult* ours = fastest(level, [](const CaseResult& c) {
+      return !other_engine(c) && c.entry->method != "none" && c.entry->method != "minimal";
+    });
+    for (const auto& engine : engines) {
+      const CaseResult* theirs =
+          fastest(level, [&](const CaseResult& c) { return other_engine(c) && engine_of(c) == engine; });
+      h << "<tr><td class=\"num\">" << format_short(level) << "</td>" << cell(ours) << "<td>"
+        << html_escape(engine) << "</td>" << cell(theirs) << "<td class=\"num\">"
+        << (ours && theirs ? format_3g(theirs->wall_median / ours->wall_median) : std::string("")) << "</td></tr>\n";
+    }
+  }
+  h << "</table>\n";
+}
+
 // Per problem: the fastest method at each accuracy level, then its pictures.
 void html_problems(std::ostream& h, const Page& pg) {
   for (const auto& p : pg.problems) {
@@ -830,6 +889,7 @@ void html_problems(std::ostream& h, const Page& pg) {
       for (double level : accuracy_levels()) html_fastest_row(h, p, m, level);
     }
     h << "</table>\n";
+    html_other_engines(h, p);
     for (const auto& name : p.plots) html_figure(h, pg.plots, name);
     if (p.plots.empty()) h << "<p>No finished runs to plot.</p>\n";
   }
