@@ -8,6 +8,7 @@
 #include <chrono>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <map>
 
 #include "io/csv.hpp"
@@ -75,6 +76,21 @@ TEST(ExternalCase, CstabRunAsAnOutsideProgramScoresLikeTheBuiltInCase) {
                                quote((s.dir() / "out").string()));
   ASSERT_EQ(again.code, 0) << again.out;
   EXPECT_TRUE(contains(again.out, "8 cached")) << again.out;
+
+  // The report draws the outside program as another engine: its curve after
+  // cstab's under the key's heading (the picture's ncstab), and an "Other
+  // engines" table per problem with the engine named by external_name's
+  // first word (no reference time within t = 2 here: its cells say "not
+  // reached").
+  const auto rep = cstab_cmd("report --no-plots " + quote((s.dir() / "out").string()));
+  ASSERT_EQ(rep.code, 0) << rep.out;
+  std::ifstream html_in(s.dir() / "out" / "report.html");
+  const std::string html((std::istreambuf_iterator<char>(html_in)), std::istreambuf_iterator<char>());
+  EXPECT_TRUE(contains(html, "<h3>Other engines</h3>"));
+  EXPECT_TRUE(contains(html, "</td><td>cstab</td><td>")) << "the engine 'cstab' (of cstab-rk4)";
+  std::ifstream replot_in(s.dir() / "out" / "plots" / "replot.sh");
+  const std::string replot((std::istreambuf_iterator<char>(replot_in)), std::istreambuf_iterator<char>());
+  EXPECT_TRUE(contains(replot, "ncstab=1")) << "one cstab curve (baumgarte/rk4) before the external one";
 }
 
 TEST(ExternalCase, AFailingHangingOrSilentProgramIsARecordedResult) {
