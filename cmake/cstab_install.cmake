@@ -8,7 +8,7 @@ set(cstab_cmake_dir ${CMAKE_INSTALL_LIBDIR}/cmake/cstab)
 install(TARGETS cstab cstab_plugin_api EXPORT cstabTargets
         RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
 install(EXPORT cstabTargets NAMESPACE cstab:: DESTINATION ${cstab_cmake_dir})
-install(DIRECTORY core linalg methods problems plugin DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/cstab
+install(DIRECTORY core linalg io methods problems plugin harness DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/cstab
         FILES_MATCHING PATTERN "*.hpp")
 install(FILES ${CSTAB_GENERATED_DIR}/cstab/build_id.hpp ${CSTAB_GENERATED_DIR}/cstab/every_method.hpp
         DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/cstab/cstab)
