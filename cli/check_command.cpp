@@ -175,21 +175,26 @@ int cmd_check(const Args& args) {
     for (const auto& m : all_methods()) {
       if (!chosen_method(m.name)) continue;
       if (!by_name && !plugin_problem && !plugin_methods.count(m.name)) continue;
+      // A check that throws (a plugin's model or method refusing, or
+      // failing) is that check's FAIL row, not bad input.
+      auto guarded = [&](const char* check, const std::string& method, auto&& run) {
+        try {
+          run();
+        } catch (const std::exception& e) {
+          rows.push_back({pname, method, check, "FAIL", std::string("threw: ") + e.what()});
+        }
+      };
       if ((plugin_problem || by_name) && !derivatives_done) {
-        check_derivatives(*p, rows);
+        guarded("derivatives", "none", [&] { check_derivatives(*p, rows); });
         derivatives_done = true;
       }
       if (!p->why_not(m.name).empty()) {
-        check_applies(*p, m, rows);
+        guarded("applies", m.name, [&] { check_applies(*p, m, rows); });
         continue;
       }
-      try {
-        check_conformance(*p, m, rows);
-        check_recovery(*p, m, rows);
-        check_allocation(*p, m, rows);
-      } catch (const std::exception& e) {
-        rows.push_back({pname, m.name, "conformance", "FAIL", std::string("error: ") + e.what()});
-      }
+      guarded("conformance", m.name, [&] { check_conformance(*p, m, rows); });
+      guarded("recovery", m.name, [&] { check_recovery(*p, m, rows); });
+      guarded("allocation", m.name, [&] { check_allocation(*p, m, rows); });
     }
   }
   if (rows.empty()) throw UsageError("nothing to check: no problem and method match --problem / --method");

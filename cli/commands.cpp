@@ -348,18 +348,26 @@ int main_command(const std::vector<std::string>& given) {
     std::cout << usage();
     return 2;
   }
+  // The --plugin flags out first (anywhere on the line), so that the
+  // command is the first word left.
+  std::vector<std::string> plugin_paths;
+  try {
+    plugin_paths = take_plugin_flags(argv);
+  } catch (const UsageError& e) {
+    std::cerr << "cstab: error: " << e.what() << "\n";
+    return 2;
+  }
+  if (argv.empty()) {
+    std::cout << usage();
+    return 2;
+  }
   const bool named = argv[0].rfind("-", 0) != 0;
   const std::string prefix = named ? "cstab " + argv[0] + ": error: " : "cstab: error: ";
   try {
-    // Plugins first (any command, anywhere on the line): they add to the
-    // lists the commands and their help read.
-    const std::vector<std::string> plugin_paths = take_plugin_flags(argv);
+    // Plugins before anything else: they add to the lists the commands and
+    // their help read.
     load_plugins_from_environment();
     for (const auto& path : plugin_paths) load_plugin(path);
-    if (argv.empty()) {
-      std::cout << usage();
-      return 2;
-    }
     if (named && !known_command(argv[0]))
       throw UsageError("unknown command '" + argv[0] + "' (known: " + command_names() + ")");
     CommandLine cli;

@@ -34,7 +34,7 @@ namespace cstab {
 ${decls}}  // namespace cstab
 
 extern \"C\" int cstab_plugin_abi(void) { return CSTAB_PLUGIN_ABI; }
-extern \"C\" const char* cstab_plugin_build_id(void) { return CSTAB_BUILD_ID; }
+extern \"C\" const char* cstab_plugin_build_id(void) { return CSTAB_PLUGIN_BUILD; }
 extern \"C\" void cstab_plugin_register(cstab::PluginRegistrar* registrar) {
 ${body}}
 ")

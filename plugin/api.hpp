@@ -15,6 +15,8 @@
 #include <utility>
 #include <vector>
 
+#include <Eigen/Core>
+
 #include "core/problem.hpp"
 #include "cstab/build_id.hpp"
 #include "methods/pair.hpp"
@@ -22,6 +24,15 @@
 // Raised whenever what a plugin and its host share changes shape (this
 // header, PairOps, the registrar).
 #define CSTAB_PLUGIN_ABI 1
+
+// What a plugin reports as its build and the loader compares with its own:
+// the installation's CSTAB_BUILD_ID, then what the compiler of each side
+// says (its version, Eigen's static alignment: a problem class's layout
+// depends on both, and a method plugin reads it through a pointer).
+#define CSTAB_PLUGIN_STR2(x) #x
+#define CSTAB_PLUGIN_STR(x) CSTAB_PLUGIN_STR2(x)
+#define CSTAB_PLUGIN_BUILD \
+  CSTAB_BUILD_ID "; " __VERSION__ "; Eigen static align " CSTAB_PLUGIN_STR(EIGEN_MAX_STATIC_ALIGN_BYTES)
 
 namespace cstab {
 
@@ -43,9 +54,10 @@ class PluginRegistrar {
 extern "C" {
 // CSTAB_PLUGIN_ABI of the headers the plugin was compiled with.
 int cstab_plugin_abi(void);
-// CSTAB_BUILD_ID of the cstab installation it was built against: the
-// version, the method catalog and problem classes (a problem plugin's pairs
-// are indexed by the catalog), the compiler.
+// CSTAB_PLUGIN_BUILD as its compiler saw it: the cstab installation it was
+// built against (the version, the method catalog and problem classes: a
+// problem plugin's pairs are indexed by the catalog; the host's compiler and
+// sanitizer setting), then its own compiler version and Eigen alignment.
 const char* cstab_plugin_build_id(void);
 // Adds the plugin's methods and problems; may throw cstab::UsageError.
 void cstab_plugin_register(cstab::PluginRegistrar* registrar);

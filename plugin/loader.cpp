@@ -3,6 +3,8 @@
 #include <dlfcn.h>
 #include <sys/stat.h>
 
+#include <algorithm>
+#include <cctype>
 #include <climits>
 #include <cstdlib>
 #include <fstream>
@@ -43,6 +45,48 @@ std::string file_identity(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   return std::to_string(bytes.size()) + "-" + hash_hex(bytes);
+}
+
+// A method or problem name becomes a CSV cell, a case folder and a plot
+// file name: letters, digits and . _ + -, starting with a letter or digit.
+std::string name_problem(const std::string& what, const std::string& name) {
+  if (name.empty()) return "a " + what + " without a name";
+  const bool first_ok = std::isalnum(static_cast<unsigned char>(name[0]));
+  const bool rest_ok = std::all_of(name.begin(), name.end(), [](char c) {
+    return std::isalnum(static_cast<unsigned char>(c)) || c == '.' || c == '_' || c == '+' || c == '-';
+  });
+  if (!first_ok || !rest_ok)
+    return what + " name '" + name + "': use letters, digits and . _ + - (starting with a letter or digit)";
+  return "";
+}
+
+// Why what a plugin registered cannot be added ("" if it can): a missing
+// or malformed name, a name given twice or already taken, nothing at all.
+std::string refusal_of(const CollectingRegistrar& r) {
+  std::set<std::string> names;
+  for (const auto& m : r.methods) {
+    if (std::string why = name_problem("method", m.info.name); !why.empty()) return why;
+    if (!names.insert("m:" + m.info.name).second) return "method '" + m.info.name + "' registered twice";
+    for (const auto& known : all_methods())
+      if (known.name == m.info.name) {
+        const std::string& o = method_origin(known.name);
+        return "method '" + m.info.name + "' is already defined (" +
+               (o.empty() ? std::string("built in") : "by " + o) + ")";
+      }
+  }
+  for (const auto& p : r.problems) {
+    if (!p) return "registers a null problem";
+    const std::string name = p->info().name;
+    if (std::string why = name_problem("problem", name); !why.empty()) return why;
+    if (!names.insert("p:" + name).second) return "problem '" + name + "' registered twice";
+    for (const auto& known : all_problems())
+      if (known->info().name == name) {
+        const std::string& o = problem_origin(name);
+        return "problem '" + name + "' is already defined (" + (o.empty() ? std::string("built in") : "by " + o) + ")";
+      }
+  }
+  if (r.methods.empty() && r.problems.empty()) return "registers no method and no problem";
+  return "";
 }
 
 template <class F>
@@ -88,56 +132,42 @@ void load_plugin(const std::string& given) {
                      std::to_string(CSTAB_PLUGIN_ABI) + ": rebuild it against this installation");
   }
   const std::string theirs = build_id() ? build_id() : "";
-  if (theirs != CSTAB_BUILD_ID) {
+  if (theirs != CSTAB_PLUGIN_BUILD) {
     ::dlclose(handle);
-    throw UsageError(who + "built against another cstab (build id " + theirs + ", this one is " + CSTAB_BUILD_ID +
-                     "): rebuild it against this installation");
+    throw UsageError(who + "built against another cstab (build id " + theirs + ", this one is " +
+                     CSTAB_PLUGIN_BUILD + "): rebuild it against this installation");
   }
-  // From here the plugin's code runs in the host; on any refusal its objects
-  // are destroyed (by the registrar) before the handle is closed.
+  // From here the plugin's code runs in the host. On any refusal its
+  // objects (the registrar's, the exception's) are gone before the handle
+  // is closed, and nothing of it has been added.
   LoadedPlugin loaded{path, file_identity(path), {}, {}};
+  std::string refusal;
   {
     CollectingRegistrar r;
     try {
       do_register(&r);
-      std::set<std::string> names;
-      for (const auto& m : r.methods) {
-        if (!names.insert("m:" + m.info.name).second)
-          throw UsageError("method '" + m.info.name + "' registered twice");
-        for (const auto& known : all_methods())
-          if (known.name == m.info.name) {
-            const std::string& o = method_origin(known.name);
-            throw UsageError("method '" + m.info.name + "' is already defined (" +
-                             (o.empty() ? std::string("built in") : "by " + o) + ")");
-          }
-      }
-      for (const auto& p : r.problems) {
-        const std::string& name = p->info().name;
-        if (!names.insert("p:" + name).second) throw UsageError("problem '" + name + "' registered twice");
-        for (const auto& known : all_problems())
-          if (known->info().name == name) {
-            const std::string& o = problem_origin(name);
-            throw UsageError("problem '" + name + "' is already defined (" +
-                             (o.empty() ? std::string("built in") : "by " + o) + ")");
-          }
-      }
-      if (r.methods.empty() && r.problems.empty()) throw UsageError("registers no method and no problem");
+      refusal = refusal_of(r);
     } catch (const std::exception& e) {
-      r.methods.clear();
-      r.problems.clear();
-      ::dlclose(handle);
-      throw UsageError(who + e.what());
+      refusal = e.what();
+    } catch (...) {
+      refusal = "its registration threw something that is not a std::exception";
     }
-    for (auto& m : r.methods) {
-      loaded.methods.push_back(m.info.name);
-      add_method(std::move(m.info), path, m.pairs);
-    }
-    for (auto& p : r.problems) {
-      loaded.problems.push_back(p->info().name);
-      add_problem(std::move(p), path);
+    if (refusal.empty()) {
+      // Every name checked: these cannot be refused.
+      for (auto& m : r.methods) {
+        loaded.methods.push_back(m.info.name);
+        add_method(std::move(m.info), path, m.pairs);
+      }
+      for (auto& p : r.problems) {
+        loaded.problems.push_back(p->info().name);
+        add_problem(std::move(p), path);
+      }
+      plugins().push_back(std::move(loaded));  // the handle stays open for the process
+      return;
     }
   }
-  plugins().push_back(std::move(loaded));  // the handle stays open for the process
+  ::dlclose(handle);
+  throw UsageError(who + refusal);
 }
 
 void load_plugins_from_environment() {
