@@ -561,12 +561,21 @@ void WorkerPool::unfinished(const MatrixCase& c, const std::string& why) {
 void WorkerPool::record(const MatrixCase& c, int wait_status, double seconds, bool timed_out) {
   // The worker's own alarm (matrix_run: start_worker) is its timeout.
   if (WIFSIGNALED(wait_status) && WTERMSIG(wait_status) == SIGALRM && c.timeout > 0) timed_out = true;
-  if (!timed_out && WIFSIGNALED(wait_status) && is_stop_signal(WTERMSIG(wait_status))) {
-    unfinished(c, std::string("worker stopped by ") + signal_name(WTERMSIG(wait_status)));
-    return;
-  }
   const std::string dir = case_folder(opt_.out_dir, c.entry.id);
   auto [outcome, reason] = worker_outcome(c, wait_status, timed_out);
+  if (!timed_out && WIFSIGNALED(wait_status) && is_stop_signal(WTERMSIG(wait_status))) {
+    // Stopped after its whole record was written (a Ctrl-C to the process
+    // group reaches a worker between case.txt and its exit): finished, kept.
+    const CaseResult done = cache_problem(dir, c, opt_.binary_id, c.keep_series && c.config.write_series).empty()
+                                ? load_case_result(opt_.out_dir, c.entry)
+                                : CaseResult{};
+    if (!done.complete || done.status == Status::kCrashed || done.status == Status::kTimeout) {
+      unfinished(c, std::string("worker stopped by ") + signal_name(WTERMSIG(wait_status)));
+      return;
+    }
+    outcome = done.status;
+    reason.clear();
+  }
   // Only simulation outcomes are cached (ok, diverged, failed, invalid,
   // timeout). A worker that crashed, was killed from outside or hit an I/O
   // error says nothing about the case: reported, not recorded, and the
