@@ -74,12 +74,47 @@ const std::array<Measure, 3> kMeasures = {{
     {"max_drift", "largest energy / first-integral drift", &CaseResult::drift},
 }};
 
-// Curves reaching `level` in `measure`, each with its fastest such case, fastest first.
-std::vector<const CaseResult*> rank_at(const std::vector<const CaseResult*>& cases, const Measure& m, double level) {
+// A case of another engine: an external case of a matrix (matrix/external.hpp).
+bool other_engine(const CaseResult& c) { return c.entry->integrator == "external"; }
+
+// The engine of an external curve: its name up to the first '-'
+// ("simbody-rkmerson" -> "simbody"), as matrices/peers.toml names them.
+std::string engine_of(const CaseResult& c) { return c.entry->method.substr(0, c.entry->method.find('-')); }
+
+// A case of a method that promises to stabilize (its conformance settings;
+// for a method this build does not know, any but the constraint-free
+// baselines none and minimal).
+bool stabilizing(const CaseResult& c) {
+  for (const MethodInfo& m : all_methods())
+    if (m.name == c.entry->method) return m.conformance.stabilizes && m.name != "minimal";
+  return c.entry->method != "none" && c.entry->method != "minimal";
+}
+
+// What a curve is in the rankings: a stabilization method (ranked), a limit
+// (a constraint-free baseline of cstab: the minimal-coordinate ODE, none, a
+// plugin that does not stabilize; shown apart, each method's time a
+// multiple of it), or another engine (an external case).
+enum class Role { kMethod, kLimit, kEngine };
+Role role_of(const CaseResult& c) {
+  if (other_engine(c)) return Role::kEngine;
+  return stabilizing(c) ? Role::kMethod : Role::kLimit;
+}
+const char* role_name(Role r) {
+  switch (r) {
+    case Role::kMethod: return "method";
+    case Role::kLimit: return "limit";
+    case Role::kEngine: return "engine";
+  }
+  return "";
+}
+
+// Curves of role `role` reaching `level` in `measure`, each with its fastest such case, fastest first.
+std::vector<const CaseResult*> rank_at(const std::vector<const CaseResult*>& cases, const Measure& m, double level,
+                                       Role role = Role::kMethod) {
   std::map<std::string, const CaseResult*> best;
   for (const CaseResult* c : cases) {
     const double v = c->*(m.value);
-    if (!timed(*c) || !(v <= level)) continue;
+    if (!timed(*c) || !(v <= level) || role_of(*c) != role) continue;
     auto& slot = best[c->entry->curve];
     if (!slot || c->wall_median < slot->wall_median) slot = c;
   }
@@ -453,18 +488,25 @@ void write_work_precision_csv(const std::string& dir, const std::vector<ProblemV
 // DIR/fastest.csv: per problem, measure and level, the curves reaching it, fastest first.
 void write_fastest_csv(const std::string& dir, const std::vector<ProblemView>& problems) {
   std::string fast =
-      "problem,measure,threshold,rank,curve,method,integrator,case_id,setting,wall_median_s,value,"
-      "ratio_to_fastest\n";
+      "problem,measure,threshold,role,rank,curve,method,integrator,case_id,setting,wall_median_s,value,"
+      "ratio_to_fastest,ratio_to_limit\n";
   for (const auto& p : problems)
     for (const Measure& m : kMeasures)
       for (double level : accuracy_levels()) {
-        const auto ranked = rank_at(p.wp, m, level);
-        for (size_t r = 0; r < ranked.size(); ++r) {
-          const CaseResult& c = *ranked[r];
-          fast += csv_line({p.name, m.key, format_short(level), std::to_string(r + 1), c.entry->curve,
-                            c.entry->method, c.entry->integrator, c.entry->id, case_setting(c),
-                            number_cell(c.wall_median), number_cell(c.*(m.value)),
-                            number_cell(c.wall_median / ranked[0]->wall_median)});
+        const auto methods = rank_at(p.wp, m, level, Role::kMethod);
+        const auto limits = rank_at(p.wp, m, level, Role::kLimit);
+        // Ratios to the fastest stabilization method and to the fastest limit.
+        const double fastest = methods.empty() ? kNaN : methods[0]->wall_median;
+        const double limit = limits.empty() ? kNaN : limits[0]->wall_median;
+        for (Role role : {Role::kMethod, Role::kLimit, Role::kEngine}) {
+          const auto ranked = role == Role::kMethod ? methods : role == Role::kLimit ? limits : rank_at(p.wp, m, level, role);
+          for (size_t r = 0; r < ranked.size(); ++r) {
+            const CaseResult& c = *ranked[r];
+            fast += csv_line({p.name, m.key, format_short(level), role_name(role), std::to_string(r + 1),
+                              c.entry->curve, c.entry->method, c.entry->integrator, c.entry->id, case_setting(c),
+                              number_cell(c.wall_median), number_cell(c.*(m.value)),
+                              number_cell(c.wall_median / fastest), number_cell(c.wall_median / limit)});
+          }
         }
       }
   write_file_atomic(dir + "/fastest.csv", fast);
@@ -505,13 +547,6 @@ struct ProblemStyle {
     return {points[j % 10], int(j % 5) + 1};
   }
 };
-
-// A case of another engine: an external case of a matrix (matrix/external.hpp).
-bool other_engine(const CaseResult& c) { return c.entry->integrator == "external"; }
-
-// The engine of an external curve: its name up to the first '-'
-// ("simbody-rkmerson" -> "simbody"), as matrices/peers.toml names them.
-std::string engine_of(const CaseResult& c) { return c.entry->method.substr(0, c.entry->method.find('-')); }
 
 // Work-precision data: one block per curve, coarse to fine, with its styles;
 // cstab's curves first, then other engines' (external cases), which the
@@ -736,7 +771,7 @@ void html_head(std::ostream& h, const Page& pg) {
 void html_fastest_cell(std::ostream& h, const ProblemView& p, double level) {
   const auto ranked = rank_at(p.wp, kMeasures[0], level);
   if (ranked.empty()) {
-    h << "<td>none reaches it</td>";
+    h << "<td>no stabilization method reaches it</td>";
     return;
   }
   h << "<td><span class=\"win\">" << html_escape(ranked[0]->entry->curve) << "</span> "
@@ -747,6 +782,10 @@ void html_fastest_cell(std::ostream& h, const ProblemView& p, double level) {
         << "&times; slower";
       break;
     }
+  const auto limits = rank_at(p.wp, kMeasures[0], level, Role::kLimit);
+  if (!limits.empty())
+    h << "; " << sci(ranked[0]->wall_median / limits[0]->wall_median) << "&times; the limit "
+      << html_escape(limits[0]->entry->curve);
   h << "</td>";
 }
 
@@ -754,7 +793,8 @@ void html_fastest_cell(std::ostream& h, const ProblemView& p, double level) {
 void html_overview(std::ostream& h, const Page& pg) {
   h << "<h2 id=\"overview\">Matrix summary</h2>\n<table><tr><th>problem</th><th>methods</th><th>integrators</th>"
        "<th>cases</th><th>ok</th><th>diverged</th><th>failed / not run</th><th>n/a</th>";
-  for (double level : {1e-6, 1e-10}) h << "<th>fastest to error &le; " << sci(level) << " (vs. next method)</th>";
+  for (double level : {1e-6, 1e-10})
+    h << "<th>fastest stabilization method to error &le; " << sci(level) << " (vs. next method, vs. limit)</th>";
   h << "</tr>\n";
   auto joined = [](const std::set<std::string>& s) {
     std::string out;
@@ -795,8 +835,13 @@ void html_fastest_row(std::ostream& h, const ProblemView& p, const Measure& m, d
     << (m.value == &CaseResult::drift && !p.drift_name.empty() ? "largest " + html_escape(p.drift_name) + " drift"
                                                                : m.title)
     << "</td><td class=\"num\">&le; " << sci(level) << "</td>";
+  const auto limits = rank_at(p.wp, m, level, Role::kLimit);
+  const std::string limit_cells =
+      limits.empty() ? std::string("<td colspan=\"2\">none reaches it</td>")
+                     : "<td>" + html_escape(limits[0]->entry->curve) + "</td><td class=\"num\">" +
+                           seconds_text(limits[0]->wall_median) + "</td>";
   if (ranked.empty()) {
-    h << "<td colspan=\"8\">no case reaches this level</td></tr>\n";
+    h << "<td colspan=\"8\">no stabilization method reaches this level</td>" << limit_cells << "<td></td></tr>\n";
     return;
   }
   const CaseResult& w = *ranked[0];
@@ -814,7 +859,61 @@ void html_fastest_row(std::ostream& h, const ProblemView& p, const Measure& m, d
       << "</td><td class=\"num\">" << sci(next->wall_median / w.wall_median) << "&times;</td>";
   else
     h << "<td colspan=\"3\">no other method reaches it</td>";
-  h << "<td class=\"num\">" << ranked.size() << " of " << p.curves.size() << "</td></tr>\n";
+  h << "<td class=\"num\">" << ranked.size() << "</td>" << limit_cells << "<td class=\"num\">"
+    << (limits.empty() ? std::string("") : sci(w.wall_median / limits[0]->wall_median) + "&times;") << "</td></tr>\n";
+}
+
+// Per problem with constraint-free baselines: at reference error 1e-6 and
+// 1e-10, each stabilization method's fastest curve, ranked, its time as a
+// multiple of the fastest method's and of each limit's; then the limits,
+// apart.
+void html_limits(std::ostream& h, const ProblemView& p) {
+  std::vector<std::string> limit_methods;
+  for (const CaseResult* c : p.wp)
+    if (role_of(*c) == Role::kLimit &&
+        std::find(limit_methods.begin(), limit_methods.end(), c->entry->method) == limit_methods.end())
+      limit_methods.push_back(c->entry->method);
+  if (limit_methods.empty()) return;
+  h << "<h3>Stabilization methods against the limits</h3>\n<p class=\"meta\">At each level of error against the "
+       "reference: each stabilization method's fastest case, ranked, with its wall time as a multiple of the fastest "
+       "method's and of each limit's. A limit is a constraint-free baseline (the minimal-coordinate ODE "
+       "<code>minimal</code>, the unstabilized <code>none</code>): what a method could cost at best, not a method to "
+       "pick for a model without minimal coordinates. Tuned gains (<code>cstab tune</code>) move the methods "
+       "closer.</p>\n<table><tr><th>error &le;</th><th>rank</th><th>fastest case</th><th>setting</th><th>wall</th>"
+       "<th>&times; fastest</th>";
+  for (const auto& l : limit_methods) h << "<th>&times; " << html_escape(l) << "</th>";
+  h << "</tr>\n";
+  // The fastest case of each method among `ranked` (fastest first).
+  auto per_method = [](const std::vector<const CaseResult*>& ranked) {
+    std::vector<const CaseResult*> out;
+    for (const CaseResult* c : ranked)
+      if (std::none_of(out.begin(), out.end(), [&](const CaseResult* o) { return o->entry->method == c->entry->method; }))
+        out.push_back(c);
+    return out;
+  };
+  for (double level : {1e-6, 1e-10}) {
+    const auto methods = per_method(rank_at(p.wp, kMeasures[0], level, Role::kMethod));
+    const auto limits = per_method(rank_at(p.wp, kMeasures[0], level, Role::kLimit));
+    auto row = [&](const std::string& rank, const CaseResult& c) {
+      h << "<tr><td class=\"num\">" << sci(level) << "</td><td>" << rank << "</td><td>"
+        << html_escape(c.entry->curve) << "</td><td>" << html_escape(case_setting(c)) << "</td><td class=\"num\">"
+        << seconds_text(c.wall_median) << "</td><td class=\"num\">"
+        << (methods.empty() ? std::string("") : sci(c.wall_median / methods[0]->wall_median) + "&times;") << "</td>";
+      for (const auto& l : limit_methods) {
+        const auto it = std::find_if(limits.begin(), limits.end(),
+                                     [&](const CaseResult* x) { return x->entry->method == l; });
+        h << "<td class=\"num\">" << (it == limits.end() ? std::string("") : sci(c.wall_median / (*it)->wall_median) + "&times;")
+          << "</td>";
+      }
+      h << "</tr>\n";
+    };
+    if (methods.empty())
+      h << "<tr><td class=\"num\">" << sci(level) << "</td><td colspan=\"" << 5 + limit_methods.size()
+        << "\">no stabilization method reaches it</td></tr>\n";
+    for (size_t r = 0; r < methods.size(); ++r) row(std::to_string(r + 1), *methods[r]);
+    for (const CaseResult* c : limits) row("<i>limit</i>", *c);
+  }
+  h << "</table>\n";
 }
 
 // A drawn picture, linked (plots/NAME.png beside report.html), with its
@@ -830,15 +929,6 @@ void html_figure(std::ostream& h, const PlotSet& plots, const std::string& name)
     << (fs::exists(base + ".svg") ? "<code>plots/" + html_escape(name) + ".svg</code>"
                                   : std::string("SVG by <code>cstab report --svg</code>"))
     << ".</figcaption></figure>\n";
-}
-
-// A case of a method that promises to stabilize (its conformance settings;
-// for a method this build does not know, any but the constraint-free
-// baselines none and minimal).
-bool stabilizing(const CaseResult& c) {
-  for (const MethodInfo& m : all_methods())
-    if (m.name == c.entry->method) return m.conformance.stabilizes && m.name != "minimal";
-  return c.entry->method != "none" && c.entry->method != "minimal";
 }
 
 // Per problem with external cases: at each reference-error level, cstab's
@@ -887,16 +977,20 @@ void html_problems(std::ostream& h, const Page& pg) {
   for (const auto& p : pg.problems) {
     h << "<h2 id=\"problem-" << html_escape(p.name) << "\">" << html_escape(p.name) << "</h2>\n";
     h << "<h3>Fastest method at each accuracy level</h3>\n"
-         "<p class=\"meta\">Among the work-precision cases that finished (status ok), the curve whose fastest case "
-         "reaches the level; the runner-up is the fastest case of another method, with its time as a multiple of "
-         "the winner's.</p>\n";
+         "<p class=\"meta\">Among the work-precision cases of stabilization methods that finished (status ok), the "
+         "curve whose fastest case reaches the level; the runner-up is the fastest case of another method, with its "
+         "time as a multiple of the winner's. The limit, apart, is the fastest constraint-free baseline "
+         "(<code>minimal</code>, <code>none</code>) reaching the level, and the winner's time as a multiple of "
+         "it.</p>\n";
     h << "<table><tr><th>error measure</th><th>level</th><th>fastest</th><th>setting</th><th>wall (median)</th>"
-         "<th>value</th><th>next other method</th><th>its wall</th><th>factor</th><th>curves reaching</th></tr>\n";
+         "<th>value</th><th>next other method</th><th>its wall</th><th>factor</th><th>curves reaching</th>"
+         "<th>limit</th><th>its wall</th><th>fastest / limit</th></tr>\n";
     for (const Measure& m : kMeasures) {
       if (m.value == &CaseResult::drift && p.drift_name.empty()) continue;
       for (double level : accuracy_levels()) html_fastest_row(h, p, m, level);
     }
     h << "</table>\n";
+    html_limits(h, p);
     html_other_engines(h, p);
     for (const auto& name : p.plots) html_figure(h, pg.plots, name);
     if (p.plots.empty()) h << "<p>No finished runs to plot.</p>\n";

@@ -14,6 +14,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <set>
 #include <sstream>
 #include <tuple>
@@ -491,6 +492,48 @@ TEST_F(MatrixRun, SingleRunWritesResultsPlotsAndReport) {
   EXPECT_NE(html.find("<img alt=\"wheel_overlay\" src=\"plots/wheel_overlay.png\">"), std::string::npos);
   EXPECT_EQ(html.find("data:image"), std::string::npos);
   EXPECT_NE(html.find("Fastest method at each accuracy level"), std::string::npos);
+}
+
+// The rankings (issue 22): stabilization methods ranked among themselves;
+// the constraint-free baselines (minimal here) apart as limits, each row's
+// time a multiple of the fastest method's and of the fastest limit's.
+TEST_F(MatrixRun, FastestTablesRankStabilizationMethodsWithLimitsApart) {
+  ASSERT_EQ(single_.code, 0) << single_.out;
+  const CsvTable f = read_csv(dir_ + "/single/fastest.csv");
+  ASSERT_FALSE(f.rows.empty());
+  // (problem, measure, threshold) -> role -> walls in rank order.
+  std::map<std::string, std::map<std::string, std::vector<double>>> groups;
+  size_t limits = 0, methods = 0;
+  for (size_t r = 0; r < f.rows.size(); ++r) {
+    const std::string method = f.get(r, "method"), role = f.get(r, "role");
+    EXPECT_EQ(role, method == "minimal" || method == "none" ? "limit" : "method") << method;
+    (role == "limit" ? limits : methods) += 1;
+    auto& walls = groups[f.get(r, "problem") + "," + f.get(r, "measure") + "," + f.get(r, "threshold")][role];
+    walls.push_back(std::stod(f.get(r, "wall_median_s")));
+    EXPECT_EQ(f.get(r, "rank"), std::to_string(walls.size()));
+  }
+  EXPECT_GT(limits, 0u);
+  EXPECT_GT(methods, 0u);
+  for (size_t r = 0; r < f.rows.size(); ++r) {
+    const auto& g = groups[f.get(r, "problem") + "," + f.get(r, "measure") + "," + f.get(r, "threshold")];
+    const double wall = std::stod(f.get(r, "wall_median_s"));
+    auto ratio_to = [&](const char* role, const char* column) {
+      const auto it = g.find(role);
+      if (it == g.end()) {
+        EXPECT_EQ(f.get(r, column), "") << column;
+        return;
+      }
+      EXPECT_NEAR(std::stod(f.get(r, column)), wall / it->second.front(), 1e-9 * wall / it->second.front());
+    };
+    ratio_to("method", "ratio_to_fastest");
+    ratio_to("limit", "ratio_to_limit");
+  }
+  for (const auto& [key, roles] : groups)
+    for (const auto& [role, walls] : roles) EXPECT_TRUE(std::is_sorted(walls.begin(), walls.end())) << key << role;
+  const std::string html = slurp(dir_ + "/single/report.html");
+  EXPECT_NE(html.find("Stabilization methods against the limits"), std::string::npos);
+  EXPECT_NE(html.find("<td><i>limit</i></td><td>minimal/rk8pd</td>"), std::string::npos);
+  EXPECT_EQ(html.find("<td class=\"win\">minimal"), std::string::npos) << "a limit crowned fastest";
 }
 
 TEST_F(MatrixRun, UnchangedRerunRunsNothing) {
