@@ -43,10 +43,13 @@ double tune_measure(const RunResult& r, const std::string& measure) {
   return std::numeric_limits<double>::quiet_NaN();
 }
 
-std::vector<double> default_tune_gains(const ParamSpec& gain) {
+std::vector<double> default_tune_gains(const ParamSpec& gain) { return tune_gains(gain, 13); }
+
+std::vector<double> tune_gains(const ParamSpec& gain, int n) {
   std::vector<double> out;
-  for (int i = -6; i <= 6; ++i) {
-    double g = std::stod(format_3g(gain.default_value * std::pow(10.0, i / 4.0)));  // 3 digits: 47.4, 84.4
+  for (int i = 0; i < n; ++i) {
+    const double exponent = -1.5 + 3.0 * i / std::max(1, n - 1);
+    double g = std::stod(format_3g(gain.default_value * std::pow(10.0, exponent)));  // 3 digits: 47.4, 84.4
     if (gain.bound == Bound::kRange || gain.bound == Bound::kInteger) g = std::clamp(g, gain.lower, gain.upper);
     g = std::min(g, gain.max_value);
     if (param_value_problem(gain, g).empty()) out.push_back(g);

@@ -67,8 +67,10 @@ struct TuneResult {
   double seconds = 0;       // wall time of the whole search
 };
 
-// 13 log-spaced values over 3 decades around the default (default x
-// 10^(-1.5 .. 1.5), 3 significant digits), clipped to the spec's bound.
+// `n` (>= 2) log-spaced values over 3 decades around the default (default x
+// 10^(-1.5 .. 1.5), 3 significant digits), clipped to the spec's bound,
+// duplicates dropped; default_tune_gains: 13 of them (4 a decade).
+std::vector<double> tune_gains(const ParamSpec& gain, int n);
 std::vector<double> default_tune_gains(const ParamSpec& gain);
 // Fixed step: 13 steps 1e-1 .. 1e-4 (4 a decade, 3 significant digits);
 // adaptive: 9 tolerances 1e-3 .. 1e-11.

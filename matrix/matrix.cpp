@@ -20,6 +20,8 @@
 
 #include "core/format.hpp"
 #include "harness/integrator.hpp"
+#include "harness/stability.hpp"
+#include "harness/tune.hpp"
 #include "io/hash.hpp"
 
 namespace cstab {
@@ -414,7 +416,7 @@ const std::vector<std::string>& known_keys() {
       "name", "problems", "methods", "formulations", "integrators", "step", "tol", "rtol", "atol",
       "t_end", "ref_time", "times", "sample_every", "blowup", "observe_every", "series", "keep_series", "repeats",
       "timeout", "repeat_if_under", "work_precision", "overlay", "optional", "perturb", "max_steps",
-      "external", "external_name", "plugins"};
+      "external", "external_name", "plugins", "tune"};
   return keys;
 }
 
@@ -621,6 +623,11 @@ std::string CaseEntry::problem_label() const {
   return problem_params.empty() ? problem : problem + "(" + problem_params + ")";
 }
 
+bool CaseEntry::tuned() const {
+  return curve.size() >= kTunedSuffix.size() &&
+         std::string_view(curve).substr(curve.size() - kTunedSuffix.size()) == kTunedSuffix;
+}
+
 std::string CaseEntry::label() const {
   std::string s = problem_label() + " " + method + (formulation.empty() ? "" : "[" + formulation + "]") + " " +
                   integrator +
@@ -656,6 +663,8 @@ struct SweepPlan {
   int observe_every = 1, repeats = 1;
   bool series = true, keep_series = false, work_precision = true, overlay = false;
   std::vector<double> perturbs;
+  int tune = 0;  // gains per tuned method (0: no tuning)
+  const MatrixValue* tune_value = nullptr;  // for messages
   std::vector<ParamChoice> params, problem_params;
   // The given problem parameters of the problem variant being expanded.
   std::vector<std::pair<std::string, std::string>> given_problem_params;
@@ -903,6 +912,11 @@ class Expander {
     if (p.perturbs.empty()) p.perturbs.push_back(0);
     p.work_precision = set.boolean("work_precision", true);
     p.overlay = set.boolean("overlay", false);
+    const double tune = set.number("tune", 0);
+    check("tune", tune == 0 || (tune >= 2 && tune <= 25 && tune == std::floor(tune)),
+          "must be an integer in [2, 25] (gains per method) or 0 (no tuning)");
+    p.tune = int(tune);
+    if (const MatrixEntry* e = set.find("tune")) p.tune_value = &e->value;
   }
 
   // Stage 8: the `param.NAME` and `param.METHOD.NAME` keys (prefix "param."),
@@ -1004,10 +1018,11 @@ class Expander {
     // MethodInfo::kind; likewise a method that steps itself and the "own"
     // integrator): impossible pairs are not cases.
     const std::vector<ParamChoice*> applying = applying_params(p, info, method, specs);
+    const Tuning tuning = tuning_of(p, info, method, specs, applying);
     std::vector<std::string> forms;
     for (const auto* f : p.formulations) forms.push_back(f->text);
     if (forms.empty()) forms.push_back("");
-    check_budget(p, forms.size(), applying);
+    check_budget(p, forms.size() * (1 + tuning.gains.size()), applying);
     for (const std::string& form : forms) {
       if (!form.empty()) {
         try {
@@ -1023,9 +1038,44 @@ class Expander {
           ++(own ? p.wrong_integrator_own : p.wrong_integrator);
           continue;
         }
-        for (const TEnd& te : p.t_ends) expand_run(p, info, method, form, *integ, te, applying);
+        for (const TEnd& te : p.t_ends) expand_run(p, info, method, form, *integ, te, applying, tuning);
       }
     }
+  }
+
+  // Key `tune = N`: the method's declared gain at N values (harness/tune:
+  // tune_gains, 3 decades around its default), its tied parameters alike,
+  // beside its default-gain cases; none for a method without a gain.
+  struct Tuning {
+    const ParamSpec* gain = nullptr;
+    std::vector<double> gains;
+  };
+  Tuning tuning_of(const SweepPlan& p, const ProblemInfo& info, const MethodInfo& method,
+                   const std::vector<ParamSpec>& specs, const std::vector<ParamChoice*>& applying) {
+    Tuning t;
+    if (p.tune == 0) return t;
+    t.gain = find_gain(specs);
+    if (!t.gain) {
+      if (!p.every_method) note(p, "tune: " + method.name + " declares no gain: its default cases only");
+      return t;
+    }
+    for (const ParamChoice* pc : applying)
+      if (pc->name == t.gain->name ||
+          std::find(t.gain->swept_with.begin(), t.gain->swept_with.end(), pc->name) != t.gain->swept_with.end())
+        throw MatrixError(pc->where, "param." + pc->name + ": tune sweeps " + method.name + "'s gain '" +
+                                         t.gain->name + "' itself (on problem '" + info.name +
+                                         "'): give one or the other");
+    if (!(t.gain->default_value > 0)) {
+      // e.g. Braun-Goldfarb's dt = 0, "the integrator's step": no scale to spread gains around.
+      if (!p.every_method)
+        note(p, "tune: " + method.name + "'s gain '" + t.gain->name + "' defaults to " +
+                    format_short(t.gain->default_value) + ": no scale to tune around (param." + method.name + "." +
+                    t.gain->name + " sweeps it): its default cases only");
+      t.gain = nullptr;
+      return t;
+    }
+    t.gains = tune_gains(*t.gain, p.tune);
+    return t;
   }
 
   // Stage 10a: the sweep's param.* keys that apply to this method, their values within its bounds.
@@ -1095,7 +1145,8 @@ class Expander {
 
   // Stage 11: one t_end: output times checked, then parameter combinations x step settings x perturb.
   void expand_run(const SweepPlan& p, const ProblemInfo& info, const MethodInfo& method, const std::string& form,
-                  const IntegratorInfo& integ, const TEnd& te, const std::vector<ParamChoice*>& applying) {
+                  const IntegratorInfo& integ, const TEnd& te, const std::vector<ParamChoice*>& applying,
+                  const Tuning& tuning) {
     double t_end = te.value;
     if (te.mode == "ref") t_end = info.reference_time > 0 ? info.reference_time : info.default_t_end;
     if (te.mode == "default") t_end = info.default_t_end;
@@ -1128,6 +1179,17 @@ class Expander {
     for_each_combination(applying, [&](const std::vector<std::pair<std::string, std::string>>& params) {
       for (const StepSettings& st : settings)
         for (const double perturb : p.perturbs) add_case(p, info, method, form, integ, t_end, params, st, perturb);
+      // The tuned cases: the gain (and its tied parameters) at each value;
+      // one curve "... tuned" per method, formulation, integrator and other
+      // parameters, whose envelope the report draws.
+      for (const double g : tuning.gains) {
+        RunConfig gained;
+        gained.params = params;
+        apply_gain(gained, *tuning.gain, g);
+        for (const StepSettings& st : settings)
+          for (const double perturb : p.perturbs)
+            add_case(p, info, method, form, integ, t_end, gained.params, st, perturb, params.size());
+      }
     });
   }
 
@@ -1159,7 +1221,7 @@ class Expander {
   // Stage 12: one case, unless an identical one is already in the expansion.
   void add_case(const SweepPlan& p, const ProblemInfo& info, const MethodInfo& method, const std::string& form,
                 const IntegratorInfo& integ, double t_end, const std::vector<std::pair<std::string, std::string>>& params,
-                const StepSettings& st, double perturb) {
+                const StepSettings& st, double perturb, size_t tuned_from = std::string::npos) {
     MatrixCase c;
     RunConfig& cfg = c.config;
     cfg.problem = info.name;
@@ -1191,9 +1253,16 @@ class Expander {
     else
       e.setting = "rtol=" + format_short(st.rtol) + ";atol=" + format_short(st.atol);
     if (perturb > 0) e.setting += ";perturb=" + format_short(perturb);
+    // A tuned case (params from index tuned_from on are the tuned gain's):
+    // its curve is named without them, and ends in " tuned".
+    const bool tuned = tuned_from != std::string::npos;
+    const std::string curve_params =
+        tuned ? join_params(std::vector<std::pair<std::string, std::string>>(
+                    params.begin(), params.begin() + std::ptrdiff_t(tuned_from)))
+              : e.params;
     e.curve = e.method + (form.empty() ? "" : "[" + form + "]") + "/" + e.integrator +
-              (e.params.empty() ? "" : " " + e.params) +
-              (e.problem_params.empty() ? "" : " (" + e.problem_params + ")");
+              (curve_params.empty() ? "" : " " + curve_params) +
+              (e.problem_params.empty() ? "" : " (" + e.problem_params + ")") + (tuned ? std::string(kTunedSuffix) : std::string());
     c.cost_estimate = estimate_cost(cfg, integ, p.repeats);
     out_.cases.push_back(std::move(c));
   }

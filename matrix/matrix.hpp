@@ -32,6 +32,7 @@
 #include <map>
 #include <set>
 #include <string>
+#include <string_view>
 #include <utility>
 #include <vector>
 
@@ -104,6 +105,9 @@ std::vector<std::string> matrix_plugins(const MatrixFile& file);
 
 // What one results folder needs to know about a case without re-expanding
 // the matrix (written to DIR/cases.csv; merge and report work from it).
+// The end of a tuned curve's name (key `tune`): "pesterev/rk4 tuned".
+inline constexpr std::string_view kTunedSuffix = " tuned";
+
 struct CaseEntry {
   size_t index = 0;         // position in the full expansion (before filter/shard)
   std::string id;           // 16 hex digits
@@ -116,8 +120,10 @@ struct CaseEntry {
   int repeats = 1;
   bool work_precision = true;  // a point of the problem's work-precision diagram
   bool overlay = false;        // candidate for the per-method time-series overlays
-  std::string curve;           // work-precision curve: method/integrator[ params]
+  std::string curve;           // work-precision curve: method/integrator[ params][ tuned]
   std::string label() const;   // one line for progress output
+  // A case of a tuned curve (key `tune`): its curve ends in kTunedSuffix.
+  bool tuned() const;
   std::string problem_label() const;  // "pendulum(length=2)", or the name alone
 };
 

@@ -552,6 +552,25 @@ struct ProblemStyle {
 // cstab's curves first, then other engines' (external cases), which the
 // picture draws with their own point and dash under the key's "other
 // engines" heading.
+// A tuned curve's envelope (key `tune`): of its cases (every gain x every
+// step or tolerance), those that no faster case beats in error against the
+// reference (in the largest residual where no case has a reference error),
+// fastest first: the best gain at each cost.
+std::vector<const CaseResult*> tuned_envelope(std::vector<const CaseResult*> cases,
+                                              const std::vector<const CaseResult*>& all) {
+  const bool by_ref = std::any_of(all.begin(), all.end(), [](const CaseResult* c) { return std::isfinite(c->ref_error); });
+  auto error = [&](const CaseResult* c) {
+    const double v = by_ref ? c->ref_error : c->max_residual;
+    return std::isfinite(v) ? v : std::numeric_limits<double>::infinity();
+  };
+  std::stable_sort(cases.begin(), cases.end(),
+                   [](const CaseResult* a, const CaseResult* b) { return a->wall_median < b->wall_median; });
+  std::vector<const CaseResult*> out;
+  for (const CaseResult* c : cases)
+    if (out.empty() ? std::isfinite(error(c)) : error(c) < error(out.back())) out.push_back(c);
+  return out;
+}
+
 struct WorkPrecisionData {
   std::string text, lcs, pts, dts;
   size_t blocks = 0, cstab_blocks = 0;
@@ -569,10 +588,14 @@ WorkPrecisionData work_precision_data(const ProblemView& p, const ProblemStyle& 
     std::stable_sort(pts_of.begin(), pts_of.end(), [](const CaseResult* a, const CaseResult* b) {
       return a->entry->t_end != b->entry->t_end ? a->entry->t_end < b->entry->t_end : case_size(*a) > case_size(*b);
     });
+    const bool tuned = pts_of[0]->entry->tuned();
+    if (tuned) pts_of = tuned_envelope(pts_of, p.wp);
     if (d.blocks++) d.text += "\n\n";
     d.text += quoted_header(curve, {"wall_median_s", "ref_error", "ref_scd", "max_residual", "max_drift", "setting"});
     auto [point, dash] = style.integrator(pts_of[0]->entry->integrator);
     if (pass == 1) point = 3, dash = 4;  // other engines: asterisks, dash-dot
+    // A tuned envelope: the open form of its integrator's point (x if it has none).
+    if (tuned) point = point % 2 == 1 && point >= 5 ? point - 1 : 2;
     d.lcs += " " + std::to_string(style.colour.at(pts_of[0]->entry->method));
     d.pts += " " + std::to_string(point);
     d.dts += " " + std::to_string(dash);
@@ -605,8 +628,9 @@ void add_work_precision_plot(PlotSet& plots, ProblemView& p, const ProblemStyle&
           "; ncstab=" + std::to_string(d.cstab_blocks),
       "Work-precision of " + p.name + ": error against wall time (median of repeats), log-log, one curve "
       "per method/integrator (colour = method, point and dash = integrator; other engines, external cases, "
-      "listed under \"other engines\" with asterisks and dash-dot lines); points from coarse to fine "
-      "step size or tolerance. Top left: max |y - y_ref| at " + ref_label + "; top right: significant "
+      "listed under \"other engines\" with asterisks and dash-dot lines; a tuned curve, matrix key tune, "
+      "drawn with open points as its envelope: of its cases at every gain, those no faster one beats in error, "
+      "fastest first); points from coarse to fine step size or tolerance. Top left: max |y - y_ref| at " + ref_label + "; top right: significant "
       "correct digits; bottom: largest constraint residual and largest " +
           (p.drift_name.empty() ? std::string("drift") : p.drift_name + " drift") +
           " over the run. Diverged and failed runs are left out."));
@@ -931,6 +955,77 @@ void html_figure(std::ostream& h, const PlotSet& plots, const std::string& name)
     << ".</figcaption></figure>\n";
 }
 
+// Per problem with tuned curves (key `tune`): at reference error 1e-6 and
+// 1e-10, each tuned curve's fastest case against its default-gain curve's,
+// the speed-up from tuning, and the method's rank among the stabilization
+// methods by default gains and tuned; a default more than 3x slower than
+// the tuned one (or not reaching a level the tuned one reaches) is flagged.
+void html_tuned(std::ostream& h, const ProblemView& p) {
+  std::vector<std::string> tuned_curves;
+  for (const std::string& curve : p.curves)
+    for (const CaseResult* c : p.wp)
+      if (c->entry->curve == curve && c->entry->tuned() && role_of(*c) == Role::kMethod) {
+        tuned_curves.push_back(curve);
+        break;
+      }
+  if (tuned_curves.empty()) return;
+  h << "<h3>Tuned gains against the defaults</h3>\n<p class=\"meta\">Matrix key <code>tune</code>: each method's "
+       "declared gain at several values around its default. At each level of error against the reference, the "
+       "fastest case of the tuned curve (every gain) and of the default-gain curve, the speed-up from tuning, and "
+       "the method's rank among the stabilization methods by their fastest default-gain case and by their fastest "
+       "case at all. <b>flagged</b>: the default gain costs more than 3&times; the tuned one, or does not reach "
+       "the level.</p>\n<table><tr><th>error &le;</th><th>tuned curve</th><th>tuned setting</th><th>wall</th>"
+       "<th>default-gain setting</th><th>wall</th><th>speed-up</th><th>rank default &rarr; tuned</th>"
+       "<th>defaults</th></tr>\n";
+  for (double level : {1e-6, 1e-10}) {
+    // The fastest case reaching `level` of each stabilization method, by default gains only and at all.
+    std::map<std::string, double> by_default, at_all;
+    for (const CaseResult* c : p.wp) {
+      if (!timed(*c) || !(c->ref_error <= level) || role_of(*c) != Role::kMethod) continue;
+      auto take = [&](std::map<std::string, double>& m) {
+        auto [it, fresh] = m.emplace(c->entry->method, c->wall_median);
+        if (!fresh) it->second = std::min(it->second, c->wall_median);
+      };
+      take(at_all);
+      if (!c->entry->tuned()) take(by_default);
+    }
+    auto rank = [](const std::map<std::string, double>& m, const std::string& method) {
+      const auto it = m.find(method);
+      if (it == m.end()) return std::string("-");
+      size_t r = 1;
+      for (const auto& [other, wall] : m) r += wall < it->second;
+      return std::to_string(r);
+    };
+    auto fastest_of = [&](const std::string& curve) {
+      const CaseResult* best = nullptr;
+      for (const CaseResult* c : p.wp)
+        if (c->entry->curve == curve && timed(*c) && c->ref_error <= level && (!best || c->wall_median < best->wall_median))
+          best = c;
+      return best;
+    };
+    for (const std::string& curve : tuned_curves) {
+      const CaseResult* t = fastest_of(curve);
+      const CaseResult* d = fastest_of(curve.substr(0, curve.size() - kTunedSuffix.size()));
+      const std::string method = p.wp.empty() ? "" : [&] {
+        for (const CaseResult* c : p.wp)
+          if (c->entry->curve == curve) return c->entry->method;
+        return std::string();
+      }();
+      auto cells = [](const CaseResult* c) {
+        return c ? "<td>" + html_escape(case_setting(*c)) + "</td><td class=\"num\">" + seconds_text(c->wall_median) +
+                       "</td>"
+                 : std::string("<td>not reached</td><td></td>");
+      };
+      const bool flagged = t && (!d || d->wall_median > 3 * t->wall_median);
+      h << "<tr><td class=\"num\">" << sci(level) << "</td><td>" << html_escape(curve) << "</td>" << cells(t)
+        << cells(d) << "<td class=\"num\">" << (t && d ? sci(d->wall_median / t->wall_median) + "&times;" : "")
+        << "</td><td>" << rank(by_default, method) << " &rarr; " << rank(at_all, method) << "</td><td>"
+        << (flagged ? "<b>flagged</b>" : (t ? "within 3&times;" : "")) << "</td></tr>\n";
+    }
+  }
+  h << "</table>\n";
+}
+
 // Per problem with external cases: at each reference-error level, cstab's
 // fastest stabilized method (the constraint-free baselines none and minimal
 // left out) against each other engine's fastest setting, as a wall-time
@@ -991,6 +1086,7 @@ void html_problems(std::ostream& h, const Page& pg) {
     }
     h << "</table>\n";
     html_limits(h, p);
+    html_tuned(h, p);
     html_other_engines(h, p);
     for (const auto& name : p.plots) html_figure(h, pg.plots, name);
     if (p.plots.empty()) h << "<p>No finished runs to plot.</p>\n";

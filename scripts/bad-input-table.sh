@@ -78,6 +78,8 @@ w unknown_formulation '[[sweep]]\nproblems = ["wheel"]\nmethods = ["pesterev"]\n
 w dae_method_ode_integrator '[[sweep]]\nproblems = ["wheel"]\nmethods = ["ida-ggl"]\nintegrators = "rk4"\nstep = 1e-3\nt_end = 0.05\n'
 w ode_method_ida '[[sweep]]\nproblems = ["wheel"]\nmethods = ["pesterev"]\nintegrators = "ida"\ntol = 1e-6\nt_end = 0.05\n'
 w method_not_applicable '[[sweep]]\nproblems = ["biped"]\nmethods = ["minimal"]\nintegrators = "rk4"\nstep = 1e-3\nt_end = 0.05\n'
+w tune_one '[[sweep]]\nproblems = ["wheel"]\nmethods = ["pesterev"]\nintegrators = "rk4"\nstep = 1e-3\nt_end = 0.05\ntune = 1\n'
+w tune_and_param '[[sweep]]\nproblems = ["wheel"]\nmethods = ["pesterev"]\nintegrators = "rk4"\nstep = 1e-3\nt_end = 0.05\ntune = 5\nparam.lambda = [10, 100]\n'
 w times_beyond '[[sweep]]\nproblems = ["wheel"]\nmethods = ["pesterev"]\nintegrators = "rk4"\nstep = 1e-3\nt_end = 0.05\ntimes = [0.01, 7]\n'
 w times_negative '[[sweep]]\nproblems = ["wheel"]\nmethods = ["pesterev"]\nintegrators = "rk4"\nstep = 1e-3\nt_end = 0.05\ntimes = -1\n'
 w repeats_zero '[[sweep]]\nproblems = ["wheel"]\nmethods = ["pesterev"]\nintegrators = "rk4"\nstep = 1e-3\nt_end = 0.05\nrepeats = 0\n'

@@ -10,6 +10,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -20,6 +21,8 @@
 #include <tuple>
 
 #include "cli/matrix_commands.hpp"
+#include "core/format.hpp"
+#include "harness/tune.hpp"
 #include "matrix/matrix.hpp"
 #include "tests/support/test_util.hpp"
 #include "methods/pair.hpp"
@@ -106,6 +109,12 @@ TEST(MatrixExpand, RejectsImpossibleSettingsAtTheirLocation) {
       {head + "timeout = 1e999\n", "m.toml:7:16: ", "'1e999' could not be interpreted"},  // toml++: out of range
       {head + "timeout = +inf\n", "m.toml:7:11: ", "'+inf' is not a finite number"},
       {head + "param.lambda = [100, nan]\n", "m.toml:7:22: ", "'nan' is not a finite number"},
+      {head + "tune = 1\n", "m.toml:7:8: ", "tune: must be an integer in [2, 25]"},
+      {head + "tune = 2.5\n", "m.toml:7:8: ", "tune: must be an integer in [2, 25]"},
+      {head + "tune = 26\n", "m.toml:7:8: ", "tune: must be an integer in [2, 25]"},
+      {head + "tune = -3\n", "m.toml:7:8: ", "tune: must be an integer in [2, 25]"},
+      {head + "tune = 5\nparam.lambda = [10, 100]\n", "m.toml:8:1: ",
+       "param.lambda: tune sweeps pesterev's gain 'lambda' itself"},
       {"[[sweep]]\nproblems = [\"wheel\"]\nmethods = [\"ida-ggl\"]\nintegrators = \"rk4\"\nstep = 1e-3\n",
        "m.toml:1:1: ", "expands to no case"},
       {"[[sweep]]\nproblems = [\"wheel\"]\nmethods = [\"pesterev\"]\nintegrators = \"ida\"\ntol = 1e-6\n",
@@ -339,6 +348,45 @@ TEST(MatrixExpand, IsDeterministicAndAppliesParametersOnlyWhereDeclared) {
                                  registry_catalog());
   ASSERT_EQ(one.cases.size(), 1u);
   EXPECT_EQ(one.cases[0].entry.id, a.cases.back().entry.id);
+}
+
+// Key `tune = N`: each method's declared gain at N values (tune_gains: 3
+// decades around the default), its tied parameters alike, as a curve
+// "... tuned" beside the default-gain cases; a method without a gain runs
+// its defaults only.
+TEST(MatrixExpand, TuneSweepsEachMethodsGainBesideItsDefaults) {
+  const auto x = expand_matrix(parse_matrix("[[sweep]]\nproblems = [\"wheel\"]\n"
+                                            "methods = [\"pesterev\", \"baumgarte\", \"minimal\"]\n"
+                                            "integrators = \"rk4\"\nstep = [1e-2, 1e-3]\nt_end = 1\ntune = 4\n",
+                                            "t.toml"),
+                               registry_catalog());
+  const std::vector<double> lambdas = tune_gains(*find_gain(all_methods()[size_t(method_index("pesterev"))].params), 4);
+  const std::vector<double> alphas = tune_gains(*find_gain(all_methods()[size_t(method_index("baumgarte"))].params), 4);
+  ASSERT_EQ(lambdas.size(), 4u);
+  ASSERT_EQ(alphas.size(), 4u);
+  // 3 decades around the default, log-spaced: the ends are default x 10^-1.5 and x 10^1.5.
+  EXPECT_NEAR(lambdas.front(), 1500 * std::pow(10, -1.5), 0.01 * lambdas.front());
+  EXPECT_NEAR(lambdas.back(), 1500 * std::pow(10, 1.5), 0.01 * lambdas.back());
+  // (1 default + 4 gains) x 2 steps for the two methods with a gain, 2 for minimal.
+  ASSERT_EQ(x.cases.size(), 2u * 5u * 2u + 2u);
+  std::map<std::string, std::set<std::string>> params_of;
+  for (const auto& c : x.cases) {
+    const CaseEntry& e = c.entry;
+    if (e.params.empty()) {
+      EXPECT_FALSE(e.tuned()) << e.curve;
+      EXPECT_EQ(e.curve, e.method + "/rk4");
+    } else {
+      EXPECT_TRUE(e.tuned()) << e.curve;
+      EXPECT_EQ(e.curve, e.method + "/rk4 tuned");
+      params_of[e.method].insert(e.params);
+    }
+  }
+  std::set<std::string> want_lambda, want_alpha;
+  for (double g : lambdas) want_lambda.insert("lambda=" + format_short(g));
+  for (double g : alphas) want_alpha.insert("alpha=" + format_short(g) + ";beta=" + format_short(g));  // beta tied
+  EXPECT_EQ(params_of["pesterev"], want_lambda);
+  EXPECT_EQ(params_of["baumgarte"], want_alpha);
+  EXPECT_EQ(params_of.count("minimal"), 0u);
 }
 
 TEST(MatrixExpand, ShardsPartitionTheCases) {
@@ -634,6 +682,79 @@ TEST_F(MatrixRun, ReportOpensInHeadlessChromiumWithEveryImageLoaded) {
   ASSERT_EQ(check.code, 0) << check.out;
   EXPECT_NE(check.out.find("images loaded"), std::string::npos) << check.out;
   EXPECT_TRUE(fs::exists(dir_ + "/shot.png"));
+}
+
+// Key `tune`: the work-precision picture draws a tuned curve as its
+// envelope (every case of the curve that no other beats in both wall time
+// and error against the reference), and the report compares each tuned
+// curve with its default-gain curve.
+TEST(MatrixTune, ReportDrawsTheEnvelopeAndComparesItWithTheDefaults) {
+  char tmpl[] = "/tmp/cstab-test-matrix-tune-XXXXXX";
+  const std::string dir = ::mkdtemp(tmpl);
+  std::ofstream(dir + "/t.toml") << "[[sweep]]\nproblems = [\"wheel\"]\nmethods = [\"pesterev\", \"minimal\"]\n"
+                                    "integrators = \"rk4\"\nstep = [1e-2, 3e-3, 1e-3]\nt_end = 1\nref_time = 1\n"
+                                    "tune = 5\nseries = false\n";
+  const Outcome o = sh(std::string(CSTAB_BINARY) + " matrix " + dir + "/t.toml --out " + dir + "/out --jobs 2");
+  ASSERT_EQ(o.code, 0) << o.out;
+  // The tuned curve's cases, from work_precision.csv: (wall, error).
+  const CsvTable wp = read_csv(dir + "/out/work_precision.csv");
+  std::vector<std::pair<double, double>> tuned;
+  for (size_t r = 0; r < wp.rows.size(); ++r)
+    if (wp.get(r, "curve") == "pesterev/rk4 tuned" && wp.get(r, "status") == "ok" && !wp.get(r, "ref_error").empty())
+      tuned.emplace_back(std::stod(wp.get(r, "wall_median_s")), std::stod(wp.get(r, "ref_error")));
+  ASSERT_EQ(tuned.size() > 5, true) << "5 gains x 3 steps, some diverge";
+  std::set<double> non_dominated;
+  for (const auto& [w, e] : tuned)
+    if (std::none_of(tuned.begin(), tuned.end(), [&](const std::pair<double, double>& d) {
+          return (d.first < w && d.second <= e) || (d.first <= w && d.second < e);
+        }))
+      non_dominated.insert(w);
+  // The picture's block of that curve.
+  const Outcome dat = sh("zcat " + dir + "/out/plots/data/wheel_work_precision.dat.gz");
+  ASSERT_EQ(dat.code, 0) << dat.out;
+  const size_t at = dat.out.find("\"pesterev/rk4 tuned\"");
+  ASSERT_NE(at, std::string::npos) << dat.out;
+  std::istringstream block(dat.out.substr(at, dat.out.find("\n\n", at) - at));
+  std::string line;
+  std::getline(block, line);  // header
+  std::set<double> drawn;
+  double last_wall = 0, last_error = INFINITY;
+  while (std::getline(block, line)) {
+    std::istringstream cells(line);
+    double wall = 0, error = 0;
+    cells >> wall >> error;
+    EXPECT_GE(wall, last_wall);
+    EXPECT_LT(error, last_error);
+    last_wall = wall;
+    last_error = error;
+    drawn.insert(wall);
+  }
+  // The same walls (the data file keeps 7 digits).
+  ASSERT_EQ(drawn.size(), non_dominated.size());
+  for (auto a = drawn.begin(), b = non_dominated.begin(); a != drawn.end(); ++a, ++b)
+    EXPECT_NEAR(*a, *b, 1e-6 * *b);
+  // The comparison table: the speed-up is the default-gain curve's fastest
+  // case reaching 1e-6 over the tuned curve's, or the default is flagged.
+  const std::string html = slurp(dir + "/out/report.html");
+  EXPECT_NE(html.find("Tuned gains against the defaults"), std::string::npos);
+  const size_t row = html.find("<tr><td class=\"num\">1e-06</td><td>pesterev/rk4 tuned</td>");
+  ASSERT_NE(row, std::string::npos);
+  auto fastest = [&](const std::string& curve) {
+    double best = INFINITY;
+    for (size_t r = 0; r < wp.rows.size(); ++r)
+      if (wp.get(r, "curve") == curve && wp.get(r, "status") == "ok" && !wp.get(r, "ref_error").empty() &&
+          std::stod(wp.get(r, "ref_error")) <= 1e-6)
+        best = std::min(best, std::stod(wp.get(r, "wall_median_s")));
+    return best;
+  };
+  const double t = fastest("pesterev/rk4 tuned"), d = fastest("pesterev/rk4");
+  ASSERT_TRUE(std::isfinite(t));
+  const std::string tr = html.substr(row, html.find("</tr>", row) - row);
+  if (!std::isfinite(d) || d > 3 * t)
+    EXPECT_NE(tr.find("<b>flagged</b>"), std::string::npos) << tr;
+  else
+    EXPECT_NE(tr.find(format_3g(d / t) + "&times;"), std::string::npos) << tr;
+  fs::remove_all(dir);
 }
 
 }  // namespace
