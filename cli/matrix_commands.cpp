@@ -83,12 +83,13 @@ methods = ["pesterev", "baumgarte", "penalty", "none", "minimal"]
 integrators = ["cvode-bdf"]
 tol = [1e-6, 1e-9]
 
-# The generalized-alpha family, the augmented Lagrangian (ali3p) and RATTLE
-# (constant-mass holonomic problems): each method is its own fixed-step
-# scheme (integrator "own"); three steps keep it to seconds per problem.
+# The generalized-alpha family, the augmented Lagrangian (ali3p), RATTLE
+# (constant-mass holonomic problems) and the symmetric projection (holonomic
+# problems): each method is its own fixed-step scheme (integrator "own");
+# three steps keep it to seconds per problem.
 [[sweep]]
 name = "wp-own"
-methods = ["generalized-alpha", "hht", "generalized-alpha-i2", "ali3p", "rattle"]
+methods = ["generalized-alpha", "hht", "generalized-alpha-i2", "ali3p", "rattle", "symmetric-projection"]
 integrators = ["own"]
 step = [1e-2, 3e-3, 1e-3]
 
