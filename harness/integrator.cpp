@@ -36,8 +36,9 @@ const std::vector<IntegratorInfo>& all_integrators() {
                            "projected error estimate): no restart after a projection", false, 5},
       {"cvode-projection-noerr", "cvode-projection without projecting the error estimate (CVodeSetProjErrEst off)",
        false, 5},
-      {"own", "the method's own implicit fixed-step scheme (generalized-alpha, hht, generalized-alpha-i2); "
-              "off-grid output by a side step of the scheme", true, 2, MethodKind::kSelfStepping},
+      {"own", "the method's own fixed-step scheme, for the methods that step themselves (their description "
+              "says --integrator own); off-grid output by a side step of the scheme",
+       true, 2, MethodKind::kSelfStepping},
     };
     add_arkode_integrators(l);
     return l;

@@ -1382,10 +1382,13 @@ class Expander {
     if (p.wrong_integrator)
       note(p, std::to_string(p.wrong_integrator) + " method x integrator combinations skipped: DAE methods (ida-*) "
               "need integrator 'ida', and 'ida' needs a DAE method");
-    if (p.wrong_integrator_own)
+    if (p.wrong_integrator_own) {
+      std::vector<std::string> own;
+      for (const MethodInfo& m : catalog_.methods)
+        if (m.kind == MethodKind::kSelfStepping) own.push_back(m.name);
       note(p, std::to_string(p.wrong_integrator_own) + " method x integrator combinations skipped: methods that are "
-              "their own scheme (generalized-alpha, hht, generalized-alpha-i2) need integrator 'own', and 'own' "
-              "needs one of them");
+              "their own scheme (" + join(own, ", ") + ") need integrator 'own', and 'own' needs one of them");
+    }
     if (out_.cases.size() == cases_before && duplicates_ == duplicates_before && !p.optional) {
       std::string why;
       for (size_t i = notes_before; i < out_.notes.size(); ++i) why += "; " + out_.notes[i];
