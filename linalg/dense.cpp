@@ -38,8 +38,21 @@ void ldlt_solve(const double* m, int n, const double* b, double* x) {
 
 namespace cstab::linalg {
 
+// Cod's rank decision: a pivot below kCodRankThreshold times the largest counts as
+// zero. Rows that are redundant on the constraint manifold (bricard's twelve
+// rows of rank 11) regain full rank a residual r away from it, with a
+// smallest singular value of order r; with Eigen's default threshold (about
+// 1e-15 relative) the pseudo-inverse then returned multipliers of order 1/r,
+// and none, projection and braun-goldfarb diverged on bricard within 2 s
+// (rk4, h = 1e-3). 1e-5 is the square root of the Schur path's pivot
+// threshold on A M^-1 A^T (1e-10, methods/index1.hpp), whose pivots are the
+// squares of these: both paths call the same states redundant.
+constexpr double kCodRankThreshold = 1e-5;
+
 struct Cod::Impl {
-  Impl(int rows, int cols) : cod(rows, cols), matrix(rows, cols), rhs(rows), x(cols) {}
+  Impl(int rows, int cols) : cod(rows, cols), matrix(rows, cols), rhs(rows), x(cols) {
+    cod.setThreshold(kCodRankThreshold);
+  }
   Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd> cod;
   Eigen::MatrixXd matrix;
   Eigen::VectorXd rhs;

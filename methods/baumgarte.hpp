@@ -65,6 +65,7 @@ class BaumgarteFormulation final : public MechanicalFormulationBase<Model> {
 
 struct BaumgarteMethod : MechanicalMethod<BaumgarteMethod> {
   static constexpr const char* kName = "baumgarte";
+  static constexpr bool kNeedsFullRank = true;  // redundant rows: does not apply, naming the rank
   static constexpr const char* kDescription =
       "Baumgarte: Phi'' + 2 alpha Phi' + beta^2 Phi = 0, Psi' + gamma Psi = 0, KKT solve (full rank)";
   static std::vector<ParamSpec> generic_params() {
@@ -75,7 +76,6 @@ struct BaumgarteMethod : MechanicalMethod<BaumgarteMethod> {
   }
   template <class Model>
   static std::unique_ptr<Formulation> make_model(const Model& model, const Params& params) {
-    require_full_rank(model, kName);
     return std::make_unique<BaumgarteFormulation<Model>>(model, params.get("alpha"), params.get("beta"),
                                                          params.get("gamma"));
   }

@@ -214,11 +214,11 @@ class MechanicalDaeFormulation final : public MechanicalFormulationBase<Model>, 
 template <class Derived, bool kGgl>
 struct IdaMethod : MechanicalMethod<Derived> {
   static constexpr bool kIsDae = true;  // F(t, y, y') = 0: needs a DAE integrator
+  static constexpr bool kNeedsFullRank = true;  // redundant rows: does not apply, naming the rank
   static ConformanceSettings conformance() { return {.integrator = "ida", .tol = 1e-9}; }
   static std::vector<ParamSpec> generic_params() { return {}; }
   template <class Model>
   static std::unique_ptr<Formulation> make_model(const Model& model, const Params&) {
-    require_full_rank(model, Derived::kName);
     return std::make_unique<MechanicalDaeFormulation<Model, kGgl>>(model, Derived::kName);
   }
 };

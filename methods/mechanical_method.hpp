@@ -2,7 +2,7 @@
 // mechanical model (P::mechanical()). A method derived from it provides
 // kName, kDescription, generic_params() and
 //   template <class Model> static std::unique_ptr<Formulation> make_model(const Model&, const Params&);
-// and may replace why_not_model / model_params (defaults below).
+// and may replace why_not_model / model_params / kNeedsFullRank (defaults below).
 #pragma once
 
 #include <memory>
@@ -16,13 +16,28 @@
 
 namespace cstab {
 
+// For methods that need full-rank constraint rows (kNeedsFullRank): the
+// reason they do not apply to a model whose rows are redundant at the
+// initial state, naming the rank; empty if the rows have full rank.
+template <class Model>
+std::string redundancy_why_not(const Model& model, const std::string& method) {
+  int rows = 0;
+  const int rank = initial_constraint_rank(model, &rows);
+  if (rank == rows) return {};
+  return "the constraint rows are redundant at the initial state (rank " + std::to_string(rank) + " of " +
+         std::to_string(rows) + "); " + method +
+         " needs full rank (braun-goldfarb, projection, post-stabilization, penalty and ali3p handle redundancy)";
+}
+
 template <class Derived>
 struct MechanicalMethod {
   template <class P>
   static std::string why_not(const P& p) {
     static_assert(contracts::check_problem<P>());
     if constexpr (contracts::HasMechanical<P>) {
-      return Derived::template why_not_model(p.mechanical());
+      std::string why = Derived::template why_not_model(p.mechanical());
+      if (why.empty() && Derived::kNeedsFullRank) why = redundancy_why_not(p.mechanical(), Derived::kName);
+      return why;
     } else {
       return "problem has no mechanical (M, Q, constraints) model";
     }
@@ -50,7 +65,8 @@ struct MechanicalMethod {
     }
   }
 
-  // Default: applies to every mechanical model.
+  // Default: applies to every mechanical model, redundant rows included.
+  static constexpr bool kNeedsFullRank = false;
   template <class Model>
   static std::string why_not_model(const Model&) { return {}; }
   template <class Model>
@@ -66,17 +82,5 @@ struct MechanicalMethod {
     }
   }
 };
-
-// For methods that need full-rank constraint rows: an error naming the
-// redundancy, thrown before the run starts.
-template <class Model>
-void require_full_rank(const Model& model, const std::string& method) {
-  int rows = 0;
-  const int rank = initial_constraint_rank(model, &rows);
-  if (rank < rows)
-    throw UsageError(method + ": the constraint rows are redundant at the initial state (rank " +
-                     std::to_string(rank) + " of " + std::to_string(rows) + "); " + method +
-                     " needs full rank (braun-goldfarb and projection handle redundancy)");
-}
 
 }  // namespace cstab

@@ -17,6 +17,7 @@
 #include "methods/affine.hpp"
 #include "methods/contracts.hpp"
 #include "methods/mechanical.hpp"
+#include "methods/mechanical_method.hpp"
 #include "linalg/small_linalg.hpp"
 
 namespace cstab {
@@ -177,11 +178,15 @@ struct PesterevMethod {
   static ConformanceSettings conformance() { return {.params = {{"lambda", "50"}}}; }
 
   template <class P>
-  static std::string why_not(const P&) {
+  static std::string why_not(const P& p) {
     static_assert(contracts::check_problem<P>());
-    return (contracts::HasStateSpace<P> || contracts::HasMechanical<P>)
-               ? ""
-               : "problem has neither an affine (state-space) nor a mechanical model";
+    if constexpr (contracts::HasStateSpace<P>) {
+      return "";
+    } else if constexpr (contracts::HasMechanical<P>) {
+      return redundancy_why_not(p.mechanical(), kName);  // A M^-1 A^T must be regular
+    } else {
+      return "problem has neither an affine (state-space) nor a mechanical model";
+    }
   }
 
   template <class P>

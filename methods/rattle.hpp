@@ -187,6 +187,7 @@ class RattleFormulation final : public SelfSteppingFormulation<Model> {
 
 struct RattleMethod : MechanicalMethod<RattleMethod> {
   static constexpr const char* kName = "rattle";
+  static constexpr bool kNeedsFullRank = true;  // redundant rows: does not apply, naming the rank
   static constexpr MethodKind kKind = MethodKind::kSelfStepping;
   static constexpr const char* kDescription =
       "RATTLE (Andersen 1983; Hairer, Lubich & Wanner VII.1.4) for --integrator own: symmetric, second order, "
@@ -237,7 +238,6 @@ struct RattleMethod : MechanicalMethod<RattleMethod> {
     } else {
       const std::string why = why_not_model(model);
       if (!why.empty()) throw UsageError(std::string(kName) + ": " + why);
-      require_full_rank(model, kName);
       RattleSettings s;
       s.tol = params.get("tol");
       s.max_iterations = int(params.get("iterations"));

@@ -203,6 +203,7 @@ class SymmetricProjectionFormulation final : public SelfSteppingFormulation<Mode
 
 struct SymmetricProjectionMethod : MechanicalMethod<SymmetricProjectionMethod> {
   static constexpr const char* kName = "symmetric-projection";
+  static constexpr bool kNeedsFullRank = true;  // redundant rows: does not apply, naming the rank
   static constexpr MethodKind kKind = MethodKind::kSelfStepping;
   static constexpr const char* kDescription =
       "Hairer's symmetric projection (BIT 2000; GNI V.4.1) around the implicit midpoint rule, for --integrator own: "
@@ -236,7 +237,6 @@ struct SymmetricProjectionMethod : MechanicalMethod<SymmetricProjectionMethod> {
     if constexpr (Model::kNonholonomic > 0) {
       throw UsageError(std::string(kName) + ": " + why_not_model(model));
     } else {
-      require_full_rank(model, kName);
       SymmetricProjectionSettings s;
       s.tol = params.get("tol");
       s.max_iterations = int(params.get("iterations"));

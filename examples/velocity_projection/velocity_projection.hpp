@@ -57,6 +57,9 @@ struct VelocityProjectionMethod : cstab::MechanicalMethod<VelocityProjectionMeth
   static constexpr const char* kDescription =
       "index-1 ODE + after each step v -= M^-1 A^T (A M^-1 A^T)^-1 (A v + b) (example plugin)";
   static std::vector<cstab::ParamSpec> generic_params() { return {}; }
+  // A M^-1 A^T by Cholesky: redundant rows (bricard) do not apply, and
+  // `cstab list` says why, naming the rank.
+  static constexpr bool kNeedsFullRank = true;
   // What `cstab check` holds it to: positions are not corrected, so it does
   // not recover from a start off the manifold; from a consistent one its
   // residual stays below the drift bound (1e-4 by default).

@@ -40,11 +40,25 @@ struct Shortfall {
   const char* method;
   double ref_error;  // the bound the pair meets at t = 2
   const char* why;
+  double residual = 0;          // > 0: the max residual it meets instead of the promise
+  double energy = 0;            // > 0: the max |dE| it meets instead of the promise
+  const char* fails_with = "";  // non-empty: it does not finish; its reason says this
 };
 const Shortfall kShortfalls[] = {
     {"pendulum", "braun-goldfarb", 1e-4,
      "the energy correction divides by |C_e N_v|^2 ~ |v|^2, which vanishes where the pendulum turns (it starts at "
      "rest): at rk4 h = 1e-3, dt = 1e-2 the error at t = 2 is 1.5e-5 with the correction, 7e-9 without (energy=0)"},
+    // Bricard's rows fold at t = 1.245: rods 2 and 3 (and 4 and 5) pass through parallel, the axes
+    // d_k x d_{k+1} vanish, and the twelve rows drop to rank 10 there (smallest nonzero singular value
+    // 0.01 at t = 1.24, 0.55 at the start; docs/problems.md).
+    {"bricard", "penalty", 0.05,
+     "the penalty stiffness p sigma^2 of the row that vanishes at the fold goes to zero with it: at alpha = 1e8 "
+     "the error at t = 2 is 2.2e-2, |dE| 0.14; at alpha = 1e10 the residual is 10x smaller and |dE| the same",
+     1e-5, 0.5},
+    {"bricard", "ali3p", 0,
+     "the augmented Lagrangian iteration stalls at the fold at small steps (relative correction ~1e-10, or ~1e-9 "
+     "with tol = 1e-9, with 50, 200 or 1000 iterations, at h = 2.5e-5 to 1e-4); at h = 1e-3 it runs through",
+     0, 0, "did not converge"},
 };
 
 const Shortfall* shortfall_of(const std::string& problem, const std::string& method) {
@@ -65,7 +79,14 @@ TEST_P(Conformance, StaysOnManifoldAndMatchesReference) {
   const double t_end = run.t_end, r0 = run.start_residual;
   const bool consistent_start = run.consistent_start;
   const RunResult& r = run.result;
+  const Shortfall* known = shortfall_of(problem_name, method);
+  if (known && *known->fails_with) {
+    EXPECT_NE(r.status, "ok") << "runs now: remove its kShortfalls row (" << known->why << ")";
+    EXPECT_NE(r.reason.find(known->fails_with), std::string::npos) << r.reason;
+    return;
+  }
   ASSERT_EQ(r.status, "ok") << r.reason;
+  const double residual_bound = known && known->residual > 0 ? known->residual : promise.residual_bound;
   EXPECT_DOUBLE_EQ(r.t_reached, t_end);
 
   if (!promise.stabilizes) {
@@ -78,9 +99,9 @@ TEST_P(Conformance, StaysOnManifoldAndMatchesReference) {
       EXPECT_GT(r.final_residual, 0.1 * r0) << "an unstabilized method recovered from the inconsistent start";
     }
   } else {
-    EXPECT_LT(r.final_residual, promise.residual_bound) << "residual at t_end";
+    EXPECT_LT(r.final_residual, residual_bound) << "residual at t_end";
     if (consistent_start) {
-      EXPECT_LT(r.max_residual, promise.residual_bound);
+      EXPECT_LT(r.max_residual, residual_bound);
     } else if (info.kind == MethodKind::kOde) {
       // From an inconsistent start (DAE and self-stepping methods project first): recovered by
       // orders of magnitude, and never worse than where it started.
@@ -89,11 +110,11 @@ TEST_P(Conformance, StaysOnManifoldAndMatchesReference) {
     }
   }
   if (problem.info().has_energy && consistent_start) {
-    EXPECT_LT(r.max_energy_drift, promise.stabilizes ? 1e-5 : 1e-2);
+    EXPECT_LT(r.max_energy_drift, known && known->energy > 0 ? known->energy : promise.stabilizes ? 1e-5 : 1e-2);
   }
   if (!r.ref_state.empty() && consistent_start) {
     const double promised = promise.stabilizes ? 1e-5 : 1e-2;
-    if (const Shortfall* known = shortfall_of(problem_name, method)) {
+    if (known) {
       EXPECT_GE(r.ref_error, promised) << "meets the promise now: remove its kShortfalls row (" << known->why << ")";
       EXPECT_LT(r.ref_error, known->ref_error) << known->why;
     } else {
