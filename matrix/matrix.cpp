@@ -664,7 +664,6 @@ struct SweepPlan {
   bool series = true, keep_series = false, work_precision = true, overlay = false;
   std::vector<double> perturbs;
   int tune = 0;  // gains per tuned method (0: no tuning)
-  const MatrixValue* tune_value = nullptr;  // for messages
   std::vector<ParamChoice> params, problem_params;
   // The given problem parameters of the problem variant being expanded.
   std::vector<std::pair<std::string, std::string>> given_problem_params;
@@ -916,7 +915,6 @@ class Expander {
     check("tune", tune == 0 || (tune >= 2 && tune <= 25 && tune == std::floor(tune)),
           "must be an integer in [2, 25] (gains per method) or 0 (no tuning)");
     p.tune = int(tune);
-    if (const MatrixEntry* e = set.find("tune")) p.tune_value = &e->value;
   }
 
   // Stage 8: the `param.NAME` and `param.METHOD.NAME` keys (prefix "param."),
@@ -1278,7 +1276,7 @@ class Expander {
     const MatrixEntry* first = set.find("external") ? set.find("external") : set.find("external_name");
     if (!cmd) throw MatrixError(first->where, "external_name: given without 'external' (the command to run)");
     if (!name) throw MatrixError(first->where, "external: needs 'external_name' (the method column of its cases)");
-    for (const char* key : {"methods", "integrators", "formulations", "perturb", "times", "observe_every"})
+    for (const char* key : {"methods", "integrators", "formulations", "perturb", "times", "observe_every", "tune"})
       if (const MatrixEntry* e = set.find(key))
         throw MatrixError(e->where, std::string(key) + ": not for an external sweep (its command is the method "
                                                         "and the integrator)");

@@ -791,6 +791,23 @@ void html_head(std::ostream& h, const Page& pg) {
   h << "<a href=\"#cases\">all cases</a><a href=\"#provenance\">provenance</a></nav>\n";
 }
 
+// The fastest timed work-precision case of `p` reaching ref error <= level
+// among those `take` accepts (nullptr if none).
+const CaseResult* fastest_case(const ProblemView& p, double level,
+                               const std::function<bool(const CaseResult&)>& take) {
+  const CaseResult* best = nullptr;
+  for (const CaseResult* c : p.wp)
+    if (timed(*c) && c->ref_error <= level && take(*c) && (!best || c->wall_median < best->wall_median)) best = c;
+  return best;
+}
+
+// The method a work-precision curve of `p` belongs to ("" if no case draws it).
+std::string method_of_curve(const ProblemView& p, const std::string& curve) {
+  for (const CaseResult* c : p.wp)
+    if (c->entry->curve == curve) return c->entry->method;
+  return {};
+}
+
 // One overview cell: the fastest curve to ref error <= level and the next method's factor.
 void html_fastest_cell(std::ostream& h, const ProblemView& p, double level) {
   const auto ranked = rank_at(p.wp, kMeasures[0], level);
@@ -997,20 +1014,12 @@ void html_tuned(std::ostream& h, const ProblemView& p) {
       return std::to_string(r);
     };
     auto fastest_of = [&](const std::string& curve) {
-      const CaseResult* best = nullptr;
-      for (const CaseResult* c : p.wp)
-        if (c->entry->curve == curve && timed(*c) && c->ref_error <= level && (!best || c->wall_median < best->wall_median))
-          best = c;
-      return best;
+      return fastest_case(p, level, [&](const CaseResult& c) { return c.entry->curve == curve; });
     };
     for (const std::string& curve : tuned_curves) {
       const CaseResult* t = fastest_of(curve);
       const CaseResult* d = fastest_of(curve.substr(0, curve.size() - kTunedSuffix.size()));
-      const std::string method = p.wp.empty() ? "" : [&] {
-        for (const CaseResult* c : p.wp)
-          if (c->entry->curve == curve) return c->entry->method;
-        return std::string();
-      }();
+      const std::string method = method_of_curve(p, curve);
       auto cells = [](const CaseResult* c) {
         return c ? "<td>" + html_escape(case_setting(*c)) + "</td><td class=\"num\">" + seconds_text(c->wall_median) +
                        "</td>"
@@ -1036,12 +1045,8 @@ void html_other_engines(std::ostream& h, const ProblemView& p) {
     if (other_engine(*c) && std::find(engines.begin(), engines.end(), engine_of(*c)) == engines.end())
       engines.push_back(engine_of(*c));
   if (engines.empty()) return;
-  // The fastest case reaching `level` among those `take` accepts.
   auto fastest = [&](double level, const std::function<bool(const CaseResult&)>& take) {
-    const CaseResult* best = nullptr;
-    for (const CaseResult* c : p.wp)
-      if (timed(*c) && c->ref_error <= level && take(*c) && (!best || c->wall_median < best->wall_median)) best = c;
-    return best;
+    return fastest_case(p, level, take);
   };
   auto cell = [](const CaseResult* c) {
     return c ? "<td>" + html_escape(c->entry->curve + " " + case_setting(*c)) + "</td><td class=\"num\">" +

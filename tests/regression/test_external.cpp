@@ -148,6 +148,7 @@ TEST(ExternalCase, AMalformedExternalSweepIsBadInput) {
            {"external = \"true {out}\"\nexternal_name = \"baumgarte\"\n", "a built-in method's name"},
            {"external = \"true {out}\"\nexternal_name = \"a b\"\n", "external_name: must be non-empty"},
            {"external = \"true {out}\"\nexternal_name = \"x\"\nparam.lambda = 1\n", "param.*: not for an external"},
+           {"external = \"true {out}\"\nexternal_name = \"x\"\ntune = 5\n", "tune: not for an external"},
        }) {
     SCOPED_TRACE(b.message);
     Scratch s;
