@@ -79,14 +79,14 @@ void rows_and_jacobian(double L, double theta, const Vec<double, 9>& z, Vec<doub
 
 }  // namespace
 
-bool BricardMinimal::solve(double theta, Vec<double, 9>& z) const {
-  Vec<double, kRows> F, Jt;
-  Eigen::Matrix<double, kRows, 9> Jz;
+bool BricardMinimal::solve(double theta, Vec<double, 9>& z, Eigen::Matrix<double, kRows, 9>& Jz,
+                           Vec<double, kRows>& Jt) const {
+  Vec<double, kRows> F;
   // Continue from the last solution in steps of at most 0.02 rad.
   const int pieces = std::max(1, static_cast<int>(std::ceil(std::abs(theta - last_theta_) / 0.02)));
   z = last_z_;
   for (int k = 1; k <= pieces; ++k) {
-    const double th = last_theta_ + (theta - last_theta_) * k / pieces;
+    const double th = k == pieces ? theta : last_theta_ + (theta - last_theta_) * k / pieces;
     bool converged = false;
     for (int it = 0; it < 50 && !converged; ++it) {
       rows_and_jacobian(p_.L, th, z, F, Jz, Jt);
@@ -104,10 +104,9 @@ bool BricardMinimal::solve(double theta, Vec<double, 9>& z) const {
 
 bool BricardMinimal::kinematics(double theta, Vec<double, 12>& q, Vec<double, 12>& w, Vec<double, 12>& dw) const {
   Vec<double, 9> z;
-  if (!solve(theta, z)) return false;
-  Vec<double, kRows> F, Jt;
+  Vec<double, kRows> Jt;
   Eigen::Matrix<double, kRows, 9> Jz;
-  rows_and_jacobian(p_.L, theta, z, F, Jz, Jt);
+  if (!solve(theta, z, Jz, Jt)) return false;
   const Eigen::ColPivHouseholderQR<Eigen::Matrix<double, kRows, 9>> qr(Jz);
   if (qr.rank() < 9) return false;  // theta is no coordinate of the motion here
   // Once: Jz z' = -Jt. Twice: Jz z'' = -d2/ds2 F(z + s z', theta + s) at s = 0.

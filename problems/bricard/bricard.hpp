@@ -151,7 +151,9 @@ class BricardMinimal {
   bool kinematics(double theta, Vec<double, 12>& q, Vec<double, 12>& w, Vec<double, 12>& dw) const;
 
  private:
-  bool solve(double theta, Vec<double, 9>& z) const;
+  // P2..P4 at theta into z, with the rows' Jacobians in z (10 x 9) and in
+  // theta there (the last Gauss-Newton evaluation).
+  bool solve(double theta, Vec<double, 9>& z, Eigen::Matrix<double, 10, 9>& Jz, Vec<double, 10>& Jt) const;
   BricardParameters p_;
   BricardMechanical mech_;
   // The last solution, the start of the next Gauss-Newton (a copy per
