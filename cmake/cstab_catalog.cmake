@@ -58,14 +58,27 @@ function(_cstab_write file content)
   file(WRITE ${file} "${content}")
 endfunction()
 
-# Under CSTAB_SANITIZE, compiles the pair unit FILE of problem class CLASS
-# without the sanitizers unless CLASS is in CSTAB_SANITIZE_CLASSES (or that
-# list is ALL).
-function(_cstab_sanitize_pair target class file)
+# Adds the pair unit FILE of problem class CLASS to TARGET. Under
+# CSTAB_SANITIZE, the pairs of the classes not in CSTAB_SANITIZE_CLASSES (or
+# none, if that list is ALL) are not instrumented: compiled with
+# -fno-sanitize=all or, when CSTAB_SANITIZE_REUSE names a built release tree
+# of the same sources, not compiled at all: that tree's object file of the
+# pair is linked as it is (scripts/sanitize.sh builds it first).
+function(_cstab_pair_source target class file)
   if(NOT CSTAB_SANITIZE OR "ALL" IN_LIST CSTAB_SANITIZE_CLASSES OR class IN_LIST CSTAB_SANITIZE_CLASSES)
-    return()
+    target_sources(${target} PRIVATE ${file})
+  elseif(CSTAB_SANITIZE_REUSE)
+    get_filename_component(name ${file} NAME)
+    set(obj ${CSTAB_SANITIZE_REUSE}/problems/CMakeFiles/${target}.dir/__/generated/pairs/${name}.o)
+    if(NOT EXISTS ${obj})
+      message(FATAL_ERROR "CSTAB_SANITIZE_REUSE: ${obj} does not exist: build the release tree ${CSTAB_SANITIZE_REUSE} first, or leave CSTAB_SANITIZE_REUSE empty")
+    endif()
+    set_source_files_properties(${obj} TARGET_DIRECTORY ${target} PROPERTIES EXTERNAL_OBJECT TRUE GENERATED TRUE)
+    target_sources(${target} PRIVATE ${obj})
+  else()
+    target_sources(${target} PRIVATE ${file})
+    set_source_files_properties(${file} TARGET_DIRECTORY ${target} PROPERTIES COMPILE_OPTIONS -fno-sanitize=all)
   endif()
-  set_source_files_properties(${file} TARGET_DIRECTORY ${target} PROPERTIES COMPILE_OPTIONS -fno-sanitize=all)
 endfunction()
 
 # Adds to METHODS_TARGET the method list and to PROBLEMS_TARGET one
@@ -161,8 +174,7 @@ std::unique_ptr<Problem> adapt_with_every_method(P problem) {
       _cstab_method_properties(${m})
       set(fn cstab_pair_${cid}_${mid})
       _cstab_write(${dir}/pairs/${cid}__${mid}.cpp "${note}#include \"${mheader}\"\n#include \"${cheader}\"\n#include \"methods/pair.hpp\"\n\nnamespace cstab {\nPairOps ${fn}() { return pair_ops<${mclass}, ${c}>(); }\n}  // namespace cstab\n")
-      target_sources(${problems_target} PRIVATE ${dir}/pairs/${cid}__${mid}.cpp)
-      _cstab_sanitize_pair(${problems_target} ${c} ${dir}/pairs/${cid}__${mid}.cpp)
+      _cstab_pair_source(${problems_target} ${c} ${dir}/pairs/${cid}__${mid}.cpp)
       string(APPEND pair_decls "PairOps ${fn}();\n")
       string(APPEND pair_calls "${fn}(), ")
     endforeach()
