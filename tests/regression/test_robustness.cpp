@@ -225,7 +225,7 @@ tol = 1e-300
   }
   EXPECT_EQ(status_of["blowup lambda=30000"], "diverged");
   EXPECT_EQ(status_of["blowup lambda=100"], "ok");
-  EXPECT_EQ(status_of["underflow lambda=1500"], "failed");
+  EXPECT_EQ(status_of["underflow lambda=6"], "failed");
   EXPECT_NE(o.out.find("1 diverged, 1 failed, 1 ok"), std::string::npos) << o.out;
 }
 

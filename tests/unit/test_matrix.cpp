@@ -365,8 +365,8 @@ TEST(MatrixExpand, TuneSweepsEachMethodsGainBesideItsDefaults) {
   ASSERT_EQ(lambdas.size(), 4u);
   ASSERT_EQ(alphas.size(), 4u);
   // 3 decades around the default, log-spaced: the ends are default x 10^-1.5 and x 10^1.5.
-  EXPECT_NEAR(lambdas.front(), 1500 * std::pow(10, -1.5), 0.01 * lambdas.front());
-  EXPECT_NEAR(lambdas.back(), 1500 * std::pow(10, 1.5), 0.01 * lambdas.back());
+  EXPECT_NEAR(lambdas.front(), 6 * std::pow(10, -1.5), 0.01 * lambdas.front());
+  EXPECT_NEAR(lambdas.back(), 6 * std::pow(10, 1.5), 0.01 * lambdas.back());
   // (1 default + 4 gains) x 2 steps for the two methods with a gain, 2 for minimal.
   ASSERT_EQ(x.cases.size(), 2u * 5u * 2u + 2u);
   std::map<std::string, std::set<std::string>> params_of;

@@ -262,7 +262,9 @@ class Folder : public ::testing::Test {
     dir_ = new Scratch("cstab_trust");
     std::ofstream(dir_->dir() / "m.toml")
         << "[[sweep]]\nproblems = [\"wheel\"]\nmethods = [\"pesterev\", \"baumgarte\"]\nintegrators = \"rk4\"\n"
-           "step = [1e-2, 3e-3]\nt_end = 1\n";
+           "step = [1e-2, 3e-3]\nt_end = 1\n"
+           // h lambda = 15 and 4.5, beyond RK4's 2.785: pesterev diverges at both steps.
+           "param.pesterev.lambda = 1500\n";
     const Outcome o = cstab_cmd("matrix " + quote(dir_->dir() / "m.toml") + " --out " + quote(shard()) +
                                 " --jobs 2 --no-report");
     ASSERT_EQ(o.code, 0) << o.out;
@@ -340,8 +342,8 @@ TEST_F(Folder, ReportRefusesAFolderWithoutCasesAndTouchesNothing) {
 TEST_F(Folder, GateUpdateNeverWritesABoundTheParserRejects) {
   const fs::path dir = copy("gate_inf");
   // A diverged case's residual (above the blow-up level 1e3) times 1e308 overflows.
-  const std::string text = "problem,method,integrator,setting,status,max_residual\n"
-                           "wheel,pesterev,rk4,step=0.003,diverged,1\n";
+  const std::string text = "problem,method,integrator,params,setting,status,max_residual\n"
+                           "wheel,pesterev,rk4,lambda=1500,step=0.003,diverged,1\n";
   std::ofstream(dir / "t.csv") << text;
   const Outcome o = cstab_cmd("gate --update --factor 1e308 --thresholds " + quote(dir / "t.csv") + " " + quote(dir));
   EXPECT_EQ(o.code, 2) << o.out;
@@ -412,7 +414,8 @@ TEST_F(Folder, AFolderInUseIsRefusedNamingItsHolderAndAStaleLockIsTakenOver) {
 TEST_F(Folder, ARefusedGateUpdateLeavesNoNewLockFile) {
   const fs::path dir = copy("gate_refused");
   fs::remove(dir / cstab::FolderLock::file_name());
-  const std::string row = "problem,method,integrator,setting,status,max_residual\nwheel,pesterev,rk4,step=0.003,ok,1\n";
+  const std::string row = "problem,method,integrator,params,setting,status,max_residual\n"
+                          "wheel,pesterev,rk4,lambda=1500,step=0.003,ok,1\n";
   std::ofstream(dir / "t.csv") << row;
   const std::string before = snapshot(dir);
   for (const std::string& bad : std::vector<std::string>{
