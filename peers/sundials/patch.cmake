@@ -4,15 +4,24 @@
 # and the solve's wall time (peer_io.h says what each does). Every edit's
 # anchor must occur exactly once, or the build stops naming it: a changed
 # example is found here, not by a wrong result.
-#   cmake -DIN=<idasSlCrank_dns.c[.gz]> -DOUT=<file.c> -P patch.cmake
-if(IN MATCHES "\\.gz$")
-  execute_process(COMMAND gzip -dc ${IN} OUTPUT_VARIABLE text RESULT_VARIABLE rc)
-  if(NOT rc EQUAL 0)
-    message(FATAL_ERROR "cannot read ${IN}")
+# SHIPPED_OUT gets the example's shipped output (SHIPPED_IN, plain or
+# gzipped) as plain text, for the test that compares the two.
+#   cmake -DIN=<idasSlCrank_dns.c[.gz]> -DOUT=<file.c>
+#         -DSHIPPED_IN=<idasSlCrank_dns.out[.gz]> -DSHIPPED_OUT=<file> -P patch.cmake
+function(read_example path var)
+  if(path MATCHES "\\.gz$")
+    execute_process(COMMAND gzip -dc ${path} OUTPUT_VARIABLE content RESULT_VARIABLE rc)
+    if(NOT rc EQUAL 0)
+      message(FATAL_ERROR "cannot read ${path}")
+    endif()
+  else()
+    file(READ ${path} content)
   endif()
-else()
-  file(READ ${IN} text)
-endif()
+  set(${var} "${content}" PARENT_SCOPE)
+endfunction()
+read_example(${SHIPPED_IN} shipped)
+file(WRITE ${SHIPPED_OUT} "${shipped}")
+read_example(${IN} text)
 
 function(edit old new)
   string(FIND "${text}" "${old}" first)
