@@ -174,8 +174,12 @@ const std::vector<Command>& commands() {
        "", declare_list, cmd_list},
       {"run", "Run one case; write DIR/summary.csv and DIR/series.csv (README.md: every column)",
        "A diverged run is a recorded result (exit 0; its status says so).", declare_run, cmd_run},
-      {"stability", "Step x gain map of a method and its measured stability boundary per step",
-       "Writes DIR/stability.csv, DIR/boundary.csv and, with gnuplot, DIR/stability.png/.svg.", declare_stability,
+      {"stability", "Step x gain map of a method and its measured stability boundary",
+       "Writes DIR/stability.csv, DIR/boundary.csv and, with gnuplot, DIR/stability.png/.svg. The boundary is in "
+       "h * rate per step when the parameter is a gain and the integrator has a real stability interval (rk4, "
+       "adams, euler), against that interval; otherwise (rho_inf, or --integrator own) it is the largest stable "
+       "step per parameter value.",
+       declare_stability,
        cmd_stability},
       {"score", "Score a trajectory computed elsewhere: the metrics of run, from a CSV of t and the coordinates",
        "Writes DIR/summary.csv and DIR/series.csv with run's columns (docs/score.md).", declare_score, cmd_score},

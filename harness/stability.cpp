@@ -2,6 +2,7 @@
 
 #include <Eigen/Dense>
 
+#include <algorithm>
 #include <cmath>
 #include <complex>
 
@@ -88,7 +89,7 @@ StabilityPoint run_point(const Problem& problem, const StabilityConfig& cfg, dou
   StabilityPoint p;
   p.step = h;
   p.gain = gain;
-  p.rate = gain_rate(spec, gain);
+  p.rate = spec.role == ParamRole::kSetting ? NAN : gain_rate(spec, gain);
   p.status = r.status;
   p.max_residual = r.max_residual;
   p.final_residual = r.final_residual;
@@ -97,6 +98,11 @@ StabilityPoint run_point(const Problem& problem, const StabilityConfig& cfg, dou
 }
 
 }  // namespace
+
+bool boundary_in_rate(const ParamSpec& spec, const std::string& integrator) {
+  const double theory = real_stability_boundary(integrator);
+  return spec.role != ParamRole::kSetting && theory > 0 && std::isfinite(theory);
+}
 
 std::vector<StabilityPoint> stability_map(const Problem& problem, const StabilityConfig& cfg) {
   std::vector<StabilityPoint> out;
@@ -126,6 +132,36 @@ std::vector<StabilityBoundary> stability_boundaries(const Problem& problem, cons
       (stable(mid) ? lo : hi) = mid;
     }
     out.push_back({h, lo / h, hi / h, std::sqrt(lo * hi), theory});
+  }
+  return out;
+}
+
+std::vector<StepBoundary> step_boundaries(const Problem& problem, const StabilityConfig& cfg,
+                                          const std::vector<StabilityPoint>& map) {
+  std::vector<double> steps = cfg.steps;
+  std::sort(steps.begin(), steps.end());
+  steps.erase(std::unique(steps.begin(), steps.end()), steps.end());
+  std::vector<StepBoundary> out;
+  for (double g : cfg.gains) {
+    auto stable_on_grid = [&](double h) {
+      for (const auto& p : map)
+        if (p.step == h && p.gain == g) return p.status == "ok";
+      return run_point(problem, cfg, h, g).status == "ok";
+    };
+    StepBoundary b{g, NAN, NAN};
+    for (double h : steps) {
+      if (!stable_on_grid(h)) {
+        b.unstable_step = h;
+        break;
+      }
+      b.stable_step = h;
+    }
+    if (std::isfinite(b.stable_step) && std::isfinite(b.unstable_step))
+      for (int i = 0; i < cfg.bisection_iterations; ++i) {
+        const double mid = std::sqrt(b.stable_step * b.unstable_step);
+        (run_point(problem, cfg, mid, g).status == "ok" ? b.stable_step : b.unstable_step) = mid;
+      }
+    out.push_back(b);
   }
   return out;
 }

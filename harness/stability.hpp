@@ -20,7 +20,7 @@ double real_stability_boundary(const std::string& integrator);
 struct StabilityPoint {
   double step = 0;
   double gain = 0;       // the parameter value given
-  double rate = 0;       // the decay rate it implies (gain, or 1/gain for dt)
+  double rate = 0;       // the decay rate it implies (gain, or 1/gain for dt); NaN if not a gain
   std::string status;    // ok | diverged | failed
   double max_residual = 0;
   double final_residual = 0;
@@ -35,12 +35,27 @@ struct StabilityConfig {
   int bisection_iterations = 10;  // boundary search per step size
 };
 
+// The boundary in h * rate, per step of the map: when the swept parameter is
+// a gain (a rate or a time scale) and the integrator has a finite real
+// stability interval (boundary_in_rate).
 struct StabilityBoundary {
   double step = 0;
   double stable_rate = 0;    // largest rate found stable
   double unstable_rate = 0;  // smallest rate found unstable
   double measured = 0;       // h * rate at the boundary (geometric mid)
   double theory = 0;         // real_stability_boundary(integrator)
+};
+
+// The boundary in the step, per parameter value of the map: when the swept
+// parameter is not a gain (generalized-alpha's rho_inf, HHT's alpha) or the
+// integrator has no finite real stability interval (a method's own implicit
+// scheme). Between the largest stable step of the grid below its first
+// unstable one and that step, bisected in log h; NaN where the grid has no
+// such step (every step stable: unstable_step NaN; none: stable_step NaN).
+struct StepBoundary {
+  double gain = 0;
+  double stable_step = 0;    // largest step found stable
+  double unstable_step = 0;  // smallest step found unstable
 };
 
 // The gain a stability map sweeps: cfg.gain_param, or the method's declared
@@ -50,7 +65,14 @@ ParamSpec gain_spec(const Problem& problem, const StabilityConfig& cfg);
 // with it (spec.swept_with, e.g. Baumgarte's beta with alpha) to the same value.
 void apply_gain(RunConfig& rc, const ParamSpec& spec, double gain);
 
+// Whether the boundary is sought in h * rate (stability_boundaries) or in the
+// step (step_boundaries).
+bool boundary_in_rate(const ParamSpec& spec, const std::string& integrator);
+
 std::vector<StabilityPoint> stability_map(const Problem& problem, const StabilityConfig& config);
 std::vector<StabilityBoundary> stability_boundaries(const Problem& problem, const StabilityConfig& config);
+// `map` is stability_map's result for `config`.
+std::vector<StepBoundary> step_boundaries(const Problem& problem, const StabilityConfig& config,
+                                          const std::vector<StabilityPoint>& map);
 
 }  // namespace cstab
