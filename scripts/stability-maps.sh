@@ -15,8 +15,8 @@ cd "$(dirname "$0")/.."
 OUT=${1:-results/stability-maps}
 CSTAB=${CSTAB:-build/release/cli/cstab}
 [ -x "$CSTAB" ] || bash scripts/build.sh
-T_END=${T_END:-1}
-STEPS=1e-3,3e-3,1e-2,3e-2,0.1,0.3
+T_END=${T_END:-ref}
+STEPS=1e-3,3e-3,1e-2,3e-2,0.1,0.3,1
 mkdir -p "$OUT"
 
 # method parameter values
@@ -31,8 +31,8 @@ own=(
 problems=(pendulum slider-crank wheel ball)
 
 {
-  echo "Largest stable step (s) over t in [0, $T_END], steps $STEPS bisected 6 times; '>= 0.3': the whole grid ran."
-  echo "A run that fails (Newton, or the method refuses the problem) counts as unstable."
+  echo "Largest stable step (s) over t in [0, $T_END], steps $STEPS bisected 6 times; '>= 1': the whole grid ran."
+  echo "T_END ref: each problem's reference time. A run that fails (Newton, or the method refuses the problem) counts as unstable."
   echo
   echo "| problem | method | parameter | value: largest stable step |"
   echo "|---|---|---|---|"
@@ -45,12 +45,12 @@ problems=(pendulum slider-crank wheel ball)
         echo "| $p | $m | $param | does not apply: $(tail -1 "$dir.log" | sed 's/|/\//g') |"
         continue
       fi
-      cells=$(awk -F, 'NR > 1 {s = ($6 == "" ? "none" : ($7 == "" ? ">= " $6 : sprintf("%.3g", $6))); printf "%s%s: %s", (NR > 2 ? "; " : ""), $5 + 0, s}' "$dir/boundary.csv")
+      cells=$(awk -F, 'NR > 1 {s = ($6 == "" ? "none" : ($7 == "" ? ">= " : "") sprintf("%.3g", $6)); printf "%s%s: %s", (NR > 2 ? "; " : ""), $5 + 0, s}' "$dir/boundary.csv")
       echo "| $p | $m | $param | $cells |"
     done
   done
   echo
-  echo "penalty on RK4, the rate omega (pendulum at rest, started 1e-9 off the manifold; wheel as it moves):"
+  echo "penalty on RK4, the rate omega over t in [0, 1] (pendulum at rest, started 1e-9 off the manifold; wheel as it moves):"
   echo
   echo "| problem | h | measured h omega | RK4 interval | ratio |"
   echo "|---|---|---|---|---|"
@@ -59,7 +59,7 @@ problems=(pendulum slider-crank wheel ball)
     [ "$p" = pendulum ] && extra=(--problem-param angle=0 --perturb 1e-9)
     dir=$OUT/$p-penalty-rk4
     "$CSTAB" stability --problem "$p" "${extra[@]}" --method penalty --integrator rk4 --gain-param omega \
-      --steps 1e-4,1e-3,1e-2 --gains 10,100,1000,1e4,1e5 --t-end "$T_END" --bisect 12 --out "$dir" >"$dir.log" 2>&1
+      --steps 1e-4,1e-3,1e-2 --gains 10,100,1000,1e4,1e5 --t-end 1 --bisect 12 --out "$dir" >"$dir.log" 2>&1
     awk -F, -v p="$p" 'NR > 1 {printf "| %s | %g | %.4g | %.4g | %.3f |\n", p, $5, $8, $9, $10}' "$dir/boundary.csv"
   done
 } >"$OUT/maps.md"
