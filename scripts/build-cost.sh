@@ -31,6 +31,9 @@ build() {  # prints wall seconds of a build of everything
 cpu_since() {  # CPU seconds and count of the units compiled since line $1 of the log
   awk -v from="$1" 'NR > from {s += $1; n++} END {printf "%.0f s CPU in %d units", s, n}' "$log"
 }
+units_since() {  # the units compiled since line $1 of the log, slowest first
+  awk -v from="$1" 'NR > from' "$log" | sort -rn | awk '{sub(".*/(build/release|src)/", "", $3); printf "    %5.1f s %6.0f MB  %s\n", $1, $2 / 1024, $3}'
+}
 
 : >"$log"
 clean=$(build)
@@ -55,6 +58,7 @@ sed -e 's/BaumgarteFormulation/ScratchFormulation/g' -e 's/BaumgarteMethod/Scrat
 echo 'cstab_method(scratch ScratchMethod methods/scratch.hpp)' >>methods/CMakeLists.txt
 cmake build/release >/dev/null
 echo "add a method (copy of baumgarte): $(build) s ($(cpu_since "$mark"))"
+units_since "$mark"
 
 mark=$(wc -l <"$log")
 mkdir problems/scratch_crank
@@ -65,4 +69,5 @@ done
 sed -i 's/foreach(problem wheel/foreach(problem scratch_crank wheel/' problems/CMakeLists.txt
 cmake build/release >/dev/null
 echo "add a problem (copy of slider-crank): $(build) s ($(cpu_since "$mark"))"
+units_since "$mark"
 build/release/cli/cstab list | grep -c 'scratch' | awk '{print "  (cstab list names scratch entries: " $1 ")"}'
