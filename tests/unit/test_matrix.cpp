@@ -580,7 +580,9 @@ TEST_F(MatrixRun, FastestTablesRankStabilizationMethodsWithLimitsApart) {
     for (const auto& [role, walls] : roles) EXPECT_TRUE(std::is_sorted(walls.begin(), walls.end())) << key << role;
   const std::string html = slurp(dir_ + "/single/report.html");
   EXPECT_NE(html.find("Stabilization methods against the limits"), std::string::npos);
-  EXPECT_NE(html.find("<td><i>limit</i></td><td>minimal/rk8pd</td>"), std::string::npos);
+  // The limit is minimal, on rk8pd or rk4: whichever of its curves reached
+  // the level in less wall time (either, on a loaded machine).
+  EXPECT_NE(html.find("<td><i>limit</i></td><td>minimal/"), std::string::npos);
   EXPECT_EQ(html.find("<td class=\"win\">minimal"), std::string::npos) << "a limit crowned fastest";
 }
 

@@ -9,64 +9,14 @@
 #include <cmath>
 
 #include "harness/run.hpp"
-#include "cstab/every_method.hpp"
+#include "tests/unit/duplicated_pendulum.hpp"
 
 namespace cstab {
+
+// Every method for the test's class, generated (tests/CMakeLists.txt).
+std::unique_ptr<Problem> cstab_adapt_DuplicatedPendulum(DuplicatedPendulum problem);
+
 namespace {
-
-// q = (x, y), unit mass, length 1, gravity -9.81 y; constraint rows
-// x^2 + y^2 - 1 (twice). Energy law 1/2 |v|^2 + g y.
-class DuplicatedPendulumModel {
- public:
-  static constexpr int kCoords = 2, kHolonomic = 2, kNonholonomic = 0;
-  static constexpr bool kHasEnergy = true;
-  std::string formulation_name() const { return "mechanical"; }
-  std::vector<ConstraintInfo> constraints() const {
-    return {{"length", "holonomic", "x^2 + y^2 - 1"}, {"length_again", "holonomic", "the same row again"}};
-  }
-  template <class S>
-  void mass(const S&, const Vec<S, 2>&, Eigen::Matrix<S, 2, 2>& M) const {
-    M.setIdentity();
-  }
-  template <class S>
-  void forces(const S&, const Vec<S, 2>&, const Vec<S, 2>&, Vec<S, 2>& Q) const {
-    Q(0) = S(0.0);
-    Q(1) = S(-9.81);
-  }
-  template <class S>
-  void holonomic(const S&, const Vec<S, 2>& q, Vec<S, 2>& phi) const {
-    phi(0) = q(0) * q(0) + q(1) * q(1) - 1.0;
-    phi(1) = phi(0);
-  }
-  template <class S>
-  S energy(const S&, const Vec<S, 2>& q, const Vec<S, 2>& v) const {
-    return 0.5 * v.dot(v) + 9.81 * q(1);
-  }
-  void initial_state(Vec<double, 2>& q, Vec<double, 2>& v) const {
-    q << std::sin(1.0), -std::cos(1.0);  // 1 rad from the bottom, at rest
-    v.setZero();
-  }
-  void to_canonical(double, const Vec<double, 2>& q, const Vec<double, 2>& v, double* c) const {
-    c[0] = q(0), c[1] = q(1), c[2] = v(0), c[3] = v(1);
-  }
-};
-
-class DuplicatedPendulum {
- public:
-  ProblemInfo info() const {
-    ProblemInfo i;
-    i.name = "duplicated-pendulum";
-    i.coordinates = {"x", "y", "xdot", "ydot"};
-    i.has_energy = true;
-    i.default_t_end = 2;
-    return i;
-  }
-  const DuplicatedPendulumModel& mechanical() const { return model_; }
-  double energy(double, const double* c) const { return 0.5 * (c[2] * c[2] + c[3] * c[3]) + 9.81 * c[1]; }
-
- private:
-  DuplicatedPendulumModel model_;
-};
 
 RunConfig config(const std::string& method, const std::string& integrator) {
   RunConfig cfg;
@@ -82,7 +32,7 @@ RunConfig config(const std::string& method, const std::string& integrator) {
 }
 
 const Problem& problem() {
-  static const std::unique_ptr<Problem> p = adapt_with_every_method(DuplicatedPendulum{});
+  static const std::unique_ptr<Problem> p = cstab_adapt_DuplicatedPendulum(DuplicatedPendulum{});
   return *p;
 }
 
