@@ -51,25 +51,26 @@ TEST(StabilityBoundary, Rk4IntervalFromItsPolynomial) {
   EXPECT_EQ(real_stability_boundary("rk8pd"), 0);
 }
 
-TEST(StabilityBoundary, PesterevOnRk4MatchesTheInterval) {
-  const auto cfg = pendulum_at_rest("pesterev", "lambda");
+// The measured boundary of `method`'s gain on RK4, as h * rate over RK4's
+// real stability interval.
+double rk4_boundary_ratio(const std::string& method, const std::string& gain) {
+  const auto cfg = pendulum_at_rest(method, gain);
   const Problem& problem = find_problem("pendulum");
-  ASSERT_TRUE(boundary_in_rate(gain_spec(problem, cfg), "rk4"));
+  EXPECT_TRUE(boundary_in_rate(gain_spec(problem, cfg), "rk4"));
   const auto b = stability_boundaries(problem, cfg);
-  ASSERT_EQ(b.size(), 1u);
-  EXPECT_NEAR(b[0].measured / b[0].theory, 1.0, 0.01) << "h * lambda = " << b[0].measured;
+  if (b.size() != 1u) return NAN;
   EXPECT_LT(b[0].stable_rate, b[0].unstable_rate);
+  return b[0].measured / b[0].theory;
+}
+
+TEST(StabilityBoundary, PesterevOnRk4MatchesTheInterval) {
+  EXPECT_NEAR(rk4_boundary_ratio("pesterev", "lambda"), 1.0, 0.01);
 }
 
 // The gain map of issue 17's penalty method: its rate omega, the same
 // interval.
 TEST(StabilityBoundary, PenaltyOnRk4MatchesTheInterval) {
-  const auto cfg = pendulum_at_rest("penalty", "omega");
-  const Problem& problem = find_problem("pendulum");
-  ASSERT_TRUE(boundary_in_rate(gain_spec(problem, cfg), "rk4"));
-  const auto b = stability_boundaries(problem, cfg);
-  ASSERT_EQ(b.size(), 1u);
-  EXPECT_NEAR(b[0].measured / b[0].theory, 1.0, 0.01) << "h * omega = " << b[0].measured;
+  EXPECT_NEAR(rk4_boundary_ratio("penalty", "omega"), 1.0, 0.01);
 }
 
 // A parameter that is not a gain (rho_inf), or a scheme with no real
