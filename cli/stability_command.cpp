@@ -124,6 +124,9 @@ int cmd_stability(const Args& args) {
   }
   const bool in_rate = boundary_in_rate(gain_spec(problem, cfg), cfg.base.integrator);
   const auto map = stability_map(problem, cfg);
+  // Every run before any file: the boundary in h * rate, or in the step.
+  const auto rate_bounds = in_rate ? stability_boundaries(problem, cfg) : std::vector<StabilityBoundary>{};
+  const auto step_bounds = in_rate ? std::vector<StepBoundary>{} : step_boundaries(problem, cfg, map);
 
   std::error_code ec;
   std::filesystem::create_directories(out, ec);
@@ -140,7 +143,7 @@ int cmd_stability(const Args& args) {
   if (in_rate) {
     bcsv = "problem,method,integrator,gain_param,step,stable_rate,unstable_rate,measured_h_rate,theory_h_rate,ratio\n";
     std::cout << "step        measured h*rate   theory   ratio\n";
-    for (const auto& b : stability_boundaries(problem, cfg)) {
+    for (const auto& b : rate_bounds) {
       bcsv += key + format_exact(b.step) + "," + num(b.stable_rate) + "," + num(b.unstable_rate) + "," +
               num(b.measured) + "," + format_exact(b.theory) + "," + num(b.measured / b.theory) + "\n";
       std::printf("%-10.3g  %-16.4g  %-7.4g  %.3f\n", b.step, b.measured, b.theory, b.measured / b.theory);
@@ -150,7 +153,7 @@ int cmd_stability(const Args& args) {
     // per value of the parameter.
     bcsv = "problem,method,integrator,gain_param,gain,stable_step,unstable_step\n";
     std::printf("%-12s  %-19s  %s\n", cfg.gain_param.c_str(), "largest stable step", "smallest unstable step");
-    for (const auto& b : step_boundaries(problem, cfg, map)) {
+    for (const auto& b : step_bounds) {
       bcsv += key + format_exact(b.gain) + "," + num(b.stable_step) + "," + num(b.unstable_step) + "\n";
       auto step = [](double h) {
         char text[32];
