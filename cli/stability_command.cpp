@@ -87,8 +87,8 @@ StabilityConfig read_stability(const Args& args, const Problem& problem) {
   for (double g : cfg.gains)
     if (const std::string why = param_value_problem(spec, g); !why.empty())
       throw UsageError("--gains: " + format_short(g) + ": " + spec.name + " " + why);
-  double total = 0, smallest = cfg.steps.front();
-  for (double h : cfg.steps) smallest = std::min(smallest, h);
+  double total = 0;
+  const double smallest = *std::min_element(cfg.steps.begin(), cfg.steps.end());
   if (boundary_in_rate(spec, cfg.base.integrator)) {
     for (double h : cfg.steps)
       total += std::ceil(cfg.base.t_end / h) * double(cfg.gains.size() + cfg.bisection_iterations + 2);
@@ -110,6 +110,7 @@ int cmd_stability(const Args& args) {
   const Problem& problem = find_problem(args.require("--problem"));
   const StabilityConfig cfg = read_stability(args, problem);
   const std::string out = args.require("--out");
+  const ParamSpec spec = gain_spec(problem, cfg);
 
   // Validate the combination (method, gain parameter) with one cheap run
   // before creating any file.
@@ -119,10 +120,10 @@ int cmd_stability(const Args& args) {
     probe.t_end = cfg.steps.front();
     probe.ref_time = 0;
     probe.write_series = false;
-    apply_gain(probe, gain_spec(problem, cfg), cfg.gains.front());
+    apply_gain(probe, spec, cfg.gains.front());
     run_case(problem, probe, "");
   }
-  const bool in_rate = boundary_in_rate(gain_spec(problem, cfg), cfg.base.integrator);
+  const bool in_rate = boundary_in_rate(spec, cfg.base.integrator);
   const auto map = stability_map(problem, cfg);
   // Every run before any file: the boundary in h * rate, or in the step.
   const auto rate_bounds = in_rate ? stability_boundaries(problem, cfg) : std::vector<StabilityBoundary>{};
@@ -153,13 +154,13 @@ int cmd_stability(const Args& args) {
     // per value of the parameter.
     bcsv = "problem,method,integrator,gain_param,gain,stable_step,unstable_step\n";
     std::printf("%-12s  %-19s  %s\n", cfg.gain_param.c_str(), "largest stable step", "smallest unstable step");
+    auto step = [](double h) {
+      char text[32];
+      std::snprintf(text, sizeof text, "%.4g", h);
+      return std::isnan(h) ? std::string("none of the grid") : std::string(text);
+    };
     for (const auto& b : step_bounds) {
       bcsv += key + format_exact(b.gain) + "," + num(b.stable_step) + "," + num(b.unstable_step) + "\n";
-      auto step = [](double h) {
-        char text[32];
-        std::snprintf(text, sizeof text, "%.4g", h);
-        return std::isnan(h) ? std::string("none of the grid") : std::string(text);
-      };
       const std::string stable = step(b.stable_step), unstable = step(b.unstable_step);
       std::printf("%-12.6g  %-19s  %s\n", b.gain, stable.c_str(), unstable.c_str());
     }
