@@ -8,28 +8,26 @@
 
 #include <cmath>
 #include <string>
-#include <utility>
 #include <vector>
 
 #include "harness/run.hpp"
 #include "problems/flyball_governor/flyball_governor.hpp"
 #include "problems/registry.hpp"
+#include "tests/support/test_util.hpp"
 
 namespace cstab {
 namespace {
 
 constexpr int kCanonical = 18;
 
+// A run to t_end with the reference at t_end: fixed-step and self-stepping
+// schemes at h = 1e-3, adaptive ones at rtol = atol = 1e-10.
 RunConfig config(const std::string& method, const std::string& integrator, double t_end) {
-  RunConfig cfg;
-  cfg.problem = "flyball-governor";
-  cfg.method = method;
-  cfg.integrator = integrator;
-  cfg.t_end = t_end;
+  StepSettings step;
+  if (integrator == "rk4" || integrator == "own") step.step = 1e-3;
+  else step.rtol = step.atol = 1e-10;
+  RunConfig cfg = testing::quiet_run_config("flyball-governor", method, integrator, step, t_end);
   cfg.ref_time = t_end;
-  cfg.write_series = false;
-  if (integrator == "rk4" || integrator == "own") cfg.step.step = 1e-3;
-  else cfg.step.rtol = cfg.step.atol = 1e-10;
   return cfg;
 }
 
