@@ -15,8 +15,10 @@
 // The position equation is solved for lambda by Newton with the Jacobian
 // G(q) (h^2/2) M^-1 G(q_n)^T at the current iterate, until |Phi| <= tol
 // (1 + |q|). Forces that depend on v (dampers) make the second half-kick
-// implicit in v1: a fixed-point iteration on Q(t_{n+1}, q1, v1), each pass
-// one linear solve for mu, until v1 changes by less than tol (1 + |v1|).
+// implicit in v1: fixed-point passes on Q(t_{n+1}, q1, v1), each one linear
+// solve for mu, until v1 changes by less than tol (1 + |v1|); when the second
+// pass still moves v1, Newton with dQ/dv by AD takes over (stiff dampers,
+// where the passes diverge once (h/2) |M^-1 dQ/dv| >= 1).
 // Taking Q at v_n in the first half-kick and at v1 in the second is the
 // trapezoidal rule in v: the scheme stays symmetric and second order; with
 // Q = Q(t, q) it is the textbook RATTLE (one force evaluation a step, the
@@ -40,6 +42,7 @@
 
 #include "core/format.hpp"
 #include "linalg/dense.hpp"
+#include "methods/contracts.hpp"
 #include "methods/ida.hpp"
 #include "methods/mechanical_method.hpp"
 #include "methods/newton_terms.hpp"
@@ -62,6 +65,7 @@ class RattleFormulation final : public SelfSteppingFormulation<Model> {
   using MatH = Eigen::Matrix<double, nh, nh>;
   using MatQH = Eigen::Matrix<double, nq, nh>;
   using VecH = Vec<double, nh>;
+  using MatHQ = Eigen::Matrix<double, nh, nq>;
 
   RattleFormulation(const Model& model, const char* method, const RattleSettings& settings)
       : Base(model, method), settings_(settings) {
@@ -73,6 +77,15 @@ class RattleFormulation final : public SelfSteppingFormulation<Model> {
   }
 
   int dimension() const override { return 2 * nq; }
+
+  // The base's Newton counters, and newton_kicks: the steps whose second
+  // half-kick needed Newton (forces that depend on v and did not settle in
+  // one fixed-point pass).
+  std::vector<std::pair<std::string, std::string>> statistics() const override {
+    auto out = Base::statistics();
+    out.emplace_back("newton_kicks", std::to_string(newton_kicks_));
+    return out;
+  }
 
   void initial_state(double* y) const override {
     VecQ q, v;
@@ -142,22 +155,36 @@ class RattleFormulation final : public SelfSteppingFormulation<Model> {
     } else {
       count_step(0, true);
     }
-    // Second half-kick, implicit in v1 through Q(t1, q1, v1).
+    // Second half-kick, implicit in v1 through Q(t1, q1, v1): v1 = F(v1) with
+    // F(v) = P(v_half + (h/2) M^-1 Q(t1, q1, v)), P the projection onto
+    // G(q1) v + Phi_t = 0. Fixed-point passes while they settle at once (Q
+    // independent of v: the second pass confirms); otherwise, from the second
+    // pass on, Newton on v - F(v) with the Jacobian I - F'(v), F' = P (h/2)
+    // M^-1 dQ/dv taken once (dQ/dv by AD): the fixed-point passes contract
+    // only while (h/2) |M^-1 dQ/dv| < 1, which stiff dampers break (the
+    // flyball governor at h = 1e-4).
     VecQ v1 = v_half;
-    bool converged = false;
+    bool converged = false, newton = false;
     double change = 0;
     for (int pass = 0; pass <= settings_.max_iterations; ++pass) {
       this->model_.forces(t1, q1, v1, Q_);
       ++evaluations_;
-      VecQ w = v_half + hh * llt_.solve(Q_);
-      if constexpr (nh > 0) w += MinvG1t_ * velocity_lu_.solve(VecH(-(terms_.A * w + terms_.phi_t)));
-      change = (w - v1).template lpNorm<Eigen::Infinity>() / (1 + w.template lpNorm<Eigen::Infinity>());
-      v1 = w;
+      VecQ dv = v_half + hh * llt_.solve(Q_);
+      if constexpr (nh > 0) dv += MinvG1t_ * velocity_lu_.solve(VecH(-(terms_.A * dv + terms_.phi_t)));
+      dv -= v1;
+      if (pass == 1 && !(dv.template lpNorm<Eigen::Infinity>() <= settings_.tol * (1 + v1.template lpNorm<Eigen::Infinity>()))) {
+        kick_newton_matrix(t1, q1, v1, hh);
+        newton = true;
+      }
+      if (newton) dv = kick_lu_.solve(dv);
+      v1 += dv;
+      change = dv.template lpNorm<Eigen::Infinity>() / (1 + v1.template lpNorm<Eigen::Infinity>());
       if (pass > 0 && change <= settings_.tol) {
         converged = true;
         break;
       }
     }
+    newton_kicks_ += newton;
     if (!converged) {
       this->failure_ = std::string(method_) + ": the implicit half-kick (forces at the new velocity) did not converge in " +
                        std::to_string(settings_.max_iterations) + " passes at t = " + format_short(t1) +
@@ -173,6 +200,24 @@ class RattleFormulation final : public SelfSteppingFormulation<Model> {
   }
 
  private:
+  // I - P (h/2) M^-1 dQ/dv at (t1, q1, v1) into kick_lu_, P = I - M^-1 G^T
+  // (G M^-1 G^T)^-1 G at q1 (the last position evaluation); dQ/dv by AD in the
+  // scalar every model's forces compile with (the contract's MechanicalDual).
+  void kick_newton_matrix(double t1, const VecQ& q1, const VecQ& v1, double hh) {
+    using D = contracts::detail::MechanicalDual<Model>;
+    Vec<D, nq> qd, vd, Qd;
+    for (int i = 0; i < nq; ++i) {
+      qd(i) = D(q1(i));
+      vd(i) = D(v1(i), nq + 1, i);
+    }
+    this->model_.forces(D(t1), qd, vd, Qd);
+    ++evaluations_;
+    for (int i = 0; i < nq; ++i) Qv_.row(i) = Qd(i).derivatives().template head<nq>().transpose();
+    MatQ F = hh * llt_.solve(Qv_);
+    if constexpr (nh > 0) F -= MinvG1t_ * velocity_lu_.solve(MatHQ(terms_.A * F));
+    kick_lu_.compute(MatQ(MatQ::Identity() - F));
+  }
+
   RattleSettings settings_;
   Eigen::LLT<MatQ> llt_;  // the constant M
   // Workspaces (no allocation per step).
@@ -180,6 +225,9 @@ class RattleFormulation final : public SelfSteppingFormulation<Model> {
   VecQ Q_;
   MatQH MinvG1t_;
   Eigen::PartialPivLU<MatH> newton_lu_, velocity_lu_;
+  MatQ Qv_;
+  Eigen::PartialPivLU<MatQ> kick_lu_;
+  long newton_kicks_ = 0;  // steps whose half-kick needed Newton
   bool have_last_ = false;
   double last_t_ = 0;
   VecQ last_q_;
