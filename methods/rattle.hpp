@@ -172,7 +172,8 @@ class RattleFormulation final : public SelfSteppingFormulation<Model> {
       VecQ dv = v_half + hh * llt_.solve(Q_);
       if constexpr (nh > 0) dv += MinvG1t_ * velocity_lu_.solve(VecH(-(terms_.A * dv + terms_.phi_t)));
       dv -= v1;
-      if (pass == 1 && !(dv.template lpNorm<Eigen::Infinity>() <= settings_.tol * (1 + v1.template lpNorm<Eigen::Infinity>()))) {
+      const double scale = 1 + v1.template lpNorm<Eigen::Infinity>();
+      if (pass == 1 && !(dv.template lpNorm<Eigen::Infinity>() <= settings_.tol * scale)) {
         kick_newton_matrix(t1, q1, v1, hh);
         newton = true;
       }
