@@ -71,6 +71,12 @@ double FlyballMechanical::angular_momentum(const Vec<double, 9>& q, const Vec<do
 //   A alpha_i'' = j'(alpha_i) theta'^2 / 2 + (m_r a + m_p L) g cos alpha_i
 //                 - T_i dl_i/dalpha_i,                      dl/dalpha = -a cos alpha (1 - s) / l
 
+// One rod's and its point mass's inertia about z at cos alpha = c.
+double FlyballMinimal::rod_inertia(double c) const {
+  const double a = p_.L / 2, L = p_.L, d = p_.d;
+  return p_.m_rod * (d + a * c) * (d + a * c) + p_.I_rod() * c * c + p_.m_point * (d + L * c) * (d + L * c);
+}
+
 void FlyballMinimal::initial_state(Vec<double, 8>& y0) const {
   const double a = p_.alpha0 * kPi / 180;
   y0 << 0, p_.s0, a, a, p_.omega0, 0, 0, 0;
@@ -84,7 +90,7 @@ bool FlyballMinimal::rhs(double, const Vec<double, 8>& y, Vec<double, 8>& dy) co
   double jp[2], force_s = -p_.m_slider * p_.g, acc_alpha[2];
   for (int i = 0; i < 2; ++i) {
     const double al = y(2 + i), ald = y(6 + i), c = std::cos(al), sn = std::sin(al);
-    J += p_.m_rod * (d + a * c) * (d + a * c) + It * c * c + p_.m_point * (d + L * c) * (d + L * c);
+    J += rod_inertia(c);
     jp[i] = -2 * sn * (p_.m_rod * a * (d + a * c) + It * c + p_.m_point * L * (d + L * c));
     Jdot += jp[i] * ald;
     const double h = 1 - s - a * sn, l = std::sqrt(a * a * c * c + h * h);
@@ -121,18 +127,12 @@ void FlyballMinimal::residuals(double t, const Vec<double, 8>& y, double* out) c
   double c[18];
   to_canonical(t, y, c);
   Vec<double, 5> phi;
-  FlyballMechanical(p_).holonomic(0.0, vmap<9>(c).eval(), phi);
+  mechanical_.holonomic(0.0, vmap<9>(c).eval(), phi);
   for (int i = 0; i < 5; ++i) out[i] = phi(i);
 }
 
 double FlyballMinimal::angular_momentum(const Vec<double, 8>& y) const {
-  const double a = p_.L / 2, It = p_.I_rod(), L = p_.L, d = p_.d;
-  double J = p_.I_axis();
-  for (int i = 0; i < 2; ++i) {
-    const double c = std::cos(y(2 + i));
-    J += p_.m_rod * (d + a * c) * (d + a * c) + It * c * c + p_.m_point * (d + L * c) * (d + L * c);
-  }
-  return J * y(4);
+  return (p_.I_axis() + rod_inertia(std::cos(y(2))) + rod_inertia(std::cos(y(3)))) * y(4);
 }
 
 // ---------------------------------------------------------------------------

@@ -155,7 +155,7 @@ class FlyballMinimal {
  public:
   static constexpr int kStates = 8;  // theta, s, alpha1, alpha2 and their rates
 
-  explicit FlyballMinimal(const FlyballParameters& p) : p_(p) {}
+  explicit FlyballMinimal(const FlyballParameters& p) : p_(p), mechanical_(p) {}
 
   std::string formulation_name() const { return "minimal"; }
   std::vector<ConstraintInfo> constraints() const { return FlyballMechanical::constraints(); }
@@ -167,7 +167,10 @@ class FlyballMinimal {
   double angular_momentum(const Vec<double, 8>& y) const;
 
  private:
+  double rod_inertia(double cos_alpha) const;
+
   FlyballParameters p_;
+  FlyballMechanical mechanical_;  // its holonomic rows, for residuals()
 };
 
 class FlyballGovernor {
