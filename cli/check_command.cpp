@@ -133,6 +133,8 @@ void check_allocation(const Problem& p, const MethodInfo& m, std::vector<Row>& r
     row.result = a.allocations == 0 ? "pass" : "FAIL";
     row.detail = std::to_string(a.allocations) + " heap allocations in " + cfg.integrator + ", " +
                  std::to_string(a.taken) + " steps";
+    if (a.library_allocations > 0)
+      row.detail += " (and " + std::to_string(a.library_allocations) + " in GSL's or SUNDIALS' own workspaces)";
   }
   rows.push_back(row);
 }

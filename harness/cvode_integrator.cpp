@@ -115,7 +115,9 @@ class CvodeIntegrator final : public SundialsIntegrator {
 
   int set_stop_time(double t_limit) override { return CVodeSetStopTime(mem_, t_limit); }
   int solve(double t_limit, double* t_returned) override {
-    return CVode(mem_, heuristic_tout(t_limit), yy_, t_returned, CV_ONE_STEP);
+    const int flag = CVode(mem_, heuristic_tout(t_limit), yy_, t_returned, CV_ONE_STEP);
+    counts_.solved();
+    return flag;
   }
   double last_step() const override {
     double h = 0;
@@ -212,7 +214,10 @@ class CvodeIntegrator final : public SundialsIntegrator {
   std::vector<double> dky_storage_;
   Counters counts_{{"cvode_steps", "cvode_rhs_evals", "cvode_jac_evals", "cvode_jac_rhs_evals", "cvode_lin_setups",
                      "cvode_nonlin_iters", "cvode_nonlin_conv_fails", "cvode_err_test_fails",
-                     "cvode_step_solve_fails"}};
+                     "cvode_step_solve_fails"},
+                    // the linear solver's (Jacobian evaluations and their
+                    // right-hand sides) are reset at the next CVode call
+                    {false, false, true, true, false, false, false, false, false}};
 };
 
 }  // namespace

@@ -59,7 +59,12 @@ template <std::size_t N>
 class CarriedCounts {
  public:
   using Counts = std::array<long, N>;
-  explicit CarriedCounts(const std::array<const char*, N>& names) : names_(names) {}
+  // `lazy`: counters a restart does not reset itself; the package resets
+  // them at the first solve after it (CVODE's linear-solver counters, zeroed
+  // by cvLsInitialize, not by CVodeReInit). Until that solve they still hold
+  // what was carried, so they read as 0.
+  explicit CarriedCounts(const std::array<const char*, N>& names, const std::array<bool, N>& lazy = {})
+      : names_(names), lazy_(lazy) {}
   // The package's counters since its last (re)start, by the queries `get`
   // (0 where a query is null or there is no solver memory).
   static Counts read(void* mem, const std::array<SundialsCounter, N>& get) {
@@ -71,21 +76,27 @@ class CarriedCounts {
   void clear() {
     carried_.fill(0);
     restarts_ = 0;
+    pending_ = false;
   }
   Counts totals(Counts raw) const {
-    for (std::size_t i = 0; i < N; ++i) raw[i] += carried_[i];
+    for (std::size_t i = 0; i < N; ++i) raw[i] = (pending_ && lazy_[i] ? 0 : raw[i]) + carried_[i];
     return raw;
   }
   // Before a restart: keep what the package counted so far.
   void before_restart(const Counts& raw) {
-    for (std::size_t i = 0; i < N; ++i) carried_[i] += raw[i];
+    for (std::size_t i = 0; i < N; ++i)
+      if (!(pending_ && lazy_[i])) carried_[i] += raw[i];
     ++restarts_;
   }
   // After it: whatever the restart left in the counters is counted again
-  // from there on (zero if it reset them).
+  // from there on (zero if it reset them); the lazy ones wait for a solve.
   void after_restart(const Counts& raw) {
-    for (std::size_t i = 0; i < N; ++i) carried_[i] -= raw[i];
+    for (std::size_t i = 0; i < N; ++i)
+      if (!lazy_[i]) carried_[i] -= raw[i];
+    pending_ = true;
   }
+  // After each solve: the lazy counters have been reset and count again.
+  void solved() { pending_ = false; }
   long restarts() const { return restarts_; }
   // The first `count` totals as summary columns (name, value).
   void append(std::vector<std::pair<std::string, std::string>>& out, const Counts& raw, std::size_t count = N) const {
@@ -95,8 +106,10 @@ class CarriedCounts {
 
  private:
   std::array<const char*, N> names_;
+  std::array<bool, N> lazy_;
   Counts carried_{};
   long restarts_ = 0;
+  bool pending_ = false;  // restarted, and no solve since
 };
 
 class SundialsIntegrator : public Integrator {

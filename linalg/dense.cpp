@@ -50,13 +50,16 @@ namespace cstab::linalg {
 constexpr double kCodRankThreshold = 1e-5;
 
 struct Cod::Impl {
-  Impl(int rows, int cols) : cod(rows, cols), matrix(rows, cols), rhs(rows), x(cols) {
+  Impl(int rows, int cols)
+      : cod(rows, cols), matrix(rows, cols), c(rows), y(cols) {
     cod.setThreshold(kCodRankThreshold);
   }
   Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd> cod;
   Eigen::MatrixXd matrix;
-  Eigen::VectorXd rhs;
-  mutable Eigen::VectorXd x;
+  // solve()'s workspaces: Eigen's own COD solve allocates its Q^T r, its
+  // reflectors' products and (for the in-place permutation) a mask on every
+  // call.
+  mutable Eigen::VectorXd c, y;
 };
 
 Cod::Cod(int rows, int cols) : impl_(std::make_unique<Impl>(rows, cols)) {}
@@ -69,10 +72,44 @@ void Cod::compute(const double* c) {
   impl_->cod.compute(impl_->matrix);
 }
 
+namespace {
+// x <- (I - tau [1; e][1; e]^T) x for x = [x0; xt]: a Householder reflector
+// on a vector, written out (Eigen's applyHouseholderOnTheLeft goes through
+// general products on dynamic blocks, which allocate).
+template <class Tail, class Essential>
+void reflect(double& x0, Tail&& xt, const Essential& e, double tau) {
+  const double w = x0 + e.dot(xt);
+  x0 -= tau * w;
+  xt -= (tau * w) * e;
+}
+}  // namespace
+
+// x = P Z^T [T11^-1 (Q^T r)(0:rank); 0], the steps of Eigen's
+// CompleteOrthogonalDecomposition::_solve_impl (Eigen 3.4) on preallocated
+// vectors, with the reflectors applied by hand.
 void Cod::solve(const double* r, double* x) const {
-  Eigen::Map<const Eigen::VectorXd> rv(r, impl_->matrix.rows());
-  impl_->x.noalias() = impl_->cod.solve(rv);
-  Eigen::Map<Eigen::VectorXd>(x, impl_->matrix.cols()) = impl_->x;
+  Impl& m = *impl_;
+  const Eigen::Index rank = m.cod.rank(), rows = m.matrix.rows(), cols = m.matrix.cols();
+  Eigen::Map<Eigen::VectorXd> xv(x, cols);
+  if (rank == 0) {
+    xv.setZero();
+    return;
+  }
+  const Eigen::MatrixXd& qtz = m.cod.matrixQTZ();
+  // c = Q^T r, Q = H(0) ... H(rank-1): H(k)'s essential part is below the
+  // diagonal in column k.
+  m.c = Eigen::Map<const Eigen::VectorXd>(r, rows);
+  for (Eigen::Index k = 0; k < rank; ++k)
+    reflect(m.c(k), m.c.tail(rows - k - 1), qtz.col(k).tail(rows - k - 1), m.cod.hCoeffs()(k));
+  m.cod.matrixT().topLeftCorner(rank, rank).template triangularView<Eigen::Upper>().solveInPlace(m.c.head(rank));
+  m.y.head(rank) = m.c.head(rank);
+  m.y.tail(cols - rank).setZero();
+  // Z^T: reflector k acts on entries k and rank .. cols-1 (its essential
+  // part is row k of the top-right block).
+  if (rank < cols)
+    for (Eigen::Index k = 0; k < rank; ++k)
+      reflect(m.y(k), m.y.tail(cols - rank), qtz.row(k).tail(cols - rank).transpose(), m.cod.zCoeffs()(k));
+  xv = m.cod.colsPermutation() * m.y;
 }
 
 int Cod::rank() const { return int(impl_->cod.rank()); }

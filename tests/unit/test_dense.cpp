@@ -1,0 +1,79 @@
+// linalg::Cod, the rank-revealing least-squares solve behind every
+// mass-weighted pseudo-inverse (linalg/weighted_pinv.hpp), against an
+// independent formulation: the SVD pseudo-inverse with the same relative
+// rank cut (singular values below 1e-5 of the largest dropped; Cod's
+// threshold is on the QR pivots, which bracket the singular values within
+// a factor of order the size, so the test matrices keep their nonzero
+// singular values far above the cut).
+#include <gtest/gtest.h>
+
+#include <Eigen/Dense>
+
+#include "linalg/dense.hpp"
+
+namespace cstab {
+namespace {
+
+Eigen::VectorXd svd_pinv_solve(const Eigen::MatrixXd& a, const Eigen::VectorXd& r) {
+  const Eigen::JacobiSVD<Eigen::MatrixXd> svd(a, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  const auto& s = svd.singularValues();
+  Eigen::VectorXd x = Eigen::VectorXd::Zero(a.cols());
+  for (Eigen::Index i = 0; i < s.size(); ++i)
+    if (s(i) > 1e-5 * s(0)) x += svd.matrixV().col(i) * (svd.matrixU().col(i).dot(r) / s(i));
+  return x;
+}
+
+void expect_matches_svd(const Eigen::MatrixXd& a, int expected_rank, unsigned seed) {
+  std::srand(seed);
+  linalg::Cod cod(int(a.rows()), int(a.cols()));
+  cod.compute(a.data());
+  EXPECT_EQ(cod.rank(), expected_rank);
+  for (int trial = 0; trial < 3; ++trial) {
+    const Eigen::VectorXd r = Eigen::VectorXd::Random(a.rows());
+    Eigen::VectorXd x(a.cols());
+    cod.solve(r.data(), x.data());
+    const Eigen::VectorXd expected = svd_pinv_solve(a, r);
+    EXPECT_LT((x - expected).norm(), 1e-12 * (1 + expected.norm())) << "rows " << a.rows() << " cols " << a.cols();
+  }
+}
+
+TEST(Cod, FullRankWideIsTheMinimumNormSolution) {
+  std::srand(1);
+  const Eigen::MatrixXd a = Eigen::MatrixXd::Random(3, 7);
+  expect_matches_svd(a, 3, 2);
+}
+
+TEST(Cod, RedundantRowsGiveTheLeastSquaresMinimumNormSolution) {
+  // Rank 3 of 5 rows (two rows repeated as combinations), 8 columns: the
+  // Z reflectors (rank < cols) and the column permutation both act.
+  std::srand(3);
+  Eigen::MatrixXd a(5, 8);
+  a.topRows(3) = Eigen::MatrixXd::Random(3, 8);
+  a.row(3) = 2 * a.row(0) - a.row(2);
+  a.row(4) = a.row(1);
+  expect_matches_svd(a, 3, 4);
+}
+
+TEST(Cod, TallAndSquareRankDeficient) {
+  std::srand(5);
+  Eigen::MatrixXd tall = Eigen::MatrixXd::Random(6, 4);
+  tall.col(3) = tall.col(0) + tall.col(1);
+  expect_matches_svd(tall, 3, 6);
+  Eigen::MatrixXd square = Eigen::MatrixXd::Random(4, 4);
+  square.row(2) = square.row(0);
+  expect_matches_svd(square, 3, 7);
+}
+
+TEST(Cod, ZeroMatrixGivesZero) {
+  const Eigen::MatrixXd a = Eigen::MatrixXd::Zero(2, 3);
+  linalg::Cod cod(2, 3);
+  cod.compute(a.data());
+  EXPECT_EQ(cod.rank(), 0);
+  const double r[2] = {1, -2};
+  double x[3] = {7, 7, 7};
+  cod.solve(r, x);
+  for (double xi : x) EXPECT_EQ(xi, 0.0);
+}
+
+}  // namespace
+}  // namespace cstab
