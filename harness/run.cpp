@@ -34,12 +34,10 @@ double significant_digits(const std::vector<double>& y, const std::vector<double
   return worst == 0 ? 17.0 : std::min(17.0, -std::log10(worst));
 }
 
-RunResult run_case(const Problem& registered, const RunConfig& cfg, const std::string& out_dir) {
-  // ---- validate everything before any file is created ----
-  std::string problem_params;
-  const std::unique_ptr<Problem> variant = problem_variant(registered, cfg.problem_params, &problem_params);
-  const Problem& problem = variant ? *variant : registered;
-  const IntegratorInfo& integ_info = find_integrator(cfg.integrator);
+namespace {
+
+// The run's numeric settings (before any formulation is built).
+void check_run_settings(const RunConfig& cfg, const IntegratorInfo& integ_info) {
   check_positive_finite(cfg.t_end, "--t-end");
   if (!(cfg.max_steps >= 1) || !std::isfinite(cfg.max_steps) || cfg.max_steps > 1e15)
     throw UsageError("--max-steps: must be a number in [1, 1e15]");
@@ -67,11 +65,17 @@ RunResult run_case(const Problem& registered, const RunConfig& cfg, const std::s
   if (!std::isfinite(cfg.drift_fit_from) || cfg.drift_fit_from < 0)
     throw UsageError("--drift-fit-from: must be a finite number >= 0 (0: no fit)");
   if (!(cfg.recovery_threshold > 0)) throw UsageError("--recovery-threshold: must be > 0");
+}
+
+// The method's formulation on the problem, checked against the integrator
+// and the perturbed start.
+std::unique_ptr<Formulation> make_checked_formulation(const Problem& problem, const RunConfig& cfg,
+                                                      const IntegratorInfo& integ_info, Params* params) {
   const std::string why = problem.why_not(cfg.method);
   if (!why.empty()) throw UsageError("--method " + cfg.method + ": " + why);
   const auto specs = problem.method_params(cfg.method, cfg.formulation);
-  const Params params = Params::resolve(specs, cfg.params, cfg.method);
-  auto form = problem.make(cfg.method, cfg.formulation, params);
+  *params = Params::resolve(specs, cfg.params, cfg.method);
+  auto form = problem.make(cfg.method, cfg.formulation, *params);
   // A DAE formulation (F(t, y, y') = 0) needs a DAE solver, a method that
   // steps itself the "own" integrator, and each of those needs one.
   const MethodKind kind = method_kind_of(*form);
@@ -83,13 +87,16 @@ RunResult run_case(const Problem& registered, const RunConfig& cfg, const std::s
   if (cfg.perturb > 0 && form->constraints_hold_by_construction())
     throw UsageError("--perturb: the " + form->formulation_name() + " formulation satisfies the constraints by construction; "
                      "there is no manifold to leave");
-  auto integrator = make_integrator(cfg.integrator, cfg.step);
-  form->set_step_hint(integ_info.fixed_step ? cfg.step.step : 0.0);
+  return form;
+}
 
-  RunResult result;
+// The result's settings, and the reference state where the run reaches the
+// reference time (result.ref_time stays 0 otherwise).
+void start_result(RunResult& result, const Problem& problem, const RunConfig& cfg, const Formulation& form,
+                  const Params& params, const std::string& problem_params) {
   result.problem = cfg.problem;
   result.problem_params = problem_params;
-  result.formulation = form->formulation_name();
+  result.formulation = form.formulation_name();
   result.method = cfg.method;
   result.params = params.describe();
   result.integrator = cfg.integrator;
@@ -108,94 +115,131 @@ RunResult run_case(const Problem& registered, const RunConfig& cfg, const std::s
     }
   }
   if (ref_time > 0) result.ref_time = ref_time;
+}
 
+void record_failure(RunResult& result, std::string reason, double t) {
+  result.status = "failed";
+  result.reason = std::move(reason);
+  result.fail_time = t;
+}
+
+// The stepping loop of one run: from t = 0 through each target time (the
+// output times, the reference time, t_end), observing as it goes.
+class RunLoop {
+ public:
+  RunLoop(const RunConfig& cfg, Formulation& form, Integrator& integrator, Recorder& recorder, RunResult& result)
+      : cfg_(cfg), form_(form), integ_(integrator), recorder_(recorder), result_(result), y_out_(form.dimension()) {
+    targets_ = cfg.times;
+    if (result.ref_time > 0) targets_.push_back(result.ref_time);
+    targets_.push_back(cfg.t_end);
+    std::sort(targets_.begin(), targets_.end());
+    targets_.erase(std::unique(targets_.begin(), targets_.end()), targets_.end());
+    output_times_ = cfg.times;  // sorted: a lookup per target stays O(log n)
+    std::sort(output_times_.begin(), output_times_.end());
+  }
+
+  void run(const double* y0) {
+    integ_.start(form_, 0.0, y0);
+    bool alive = recorder_.observe(0.0, y0, true, cfg_.blowup);
+    for (double target : targets_) {
+      if (!alive || !advance_to(target)) break;
+      alive = observe_target(target);
+    }
+  }
+
+ private:
+  // Steps until t reaches `target` (observing on the way); false if the run
+  // ended (failed or diverged).
+  bool advance_to(double target) {
+    while (integ_.t() < target) {
+      if (double(integ_.steps()) >= cfg_.max_steps) {
+        record_failure(result_,
+                       "step limit: " + format_short(cfg_.max_steps) + " steps taken by t = " +
+                           format_short(integ_.t()) + " (--max-steps raises it)",
+                       integ_.t());
+        return false;
+      }
+      const StepOutcome outcome = integ_.step(target);
+      if (outcome == StepOutcome::kPastLimit) break;
+      if (outcome == StepOutcome::kFailed ||
+          (form_.has_post_step() && !integ_.applies_post_step() && form_.post_step(integ_.t(), integ_.y()) &&
+           !integ_.notify_modified())) {
+        record_failure(result_, integ_.failure_reason(), integ_.t());
+        return false;
+      }
+      // A step that reaches the target is observed by observe_target, once.
+      if (integ_.t() < target && (++since_observed_ >= cfg_.observe_every || recorder_.due_for_sample(integ_.t()))) {
+        since_observed_ = 0;
+        if (!recorder_.observe(integ_.t(), integ_.y(), false, cfg_.blowup)) return false;
+      }
+    }
+    return true;
+  }
+
+  // The exact state at `target`, observed; the error against the reference
+  // there, and the final state. False if the run ended.
+  bool observe_target(double target) {
+    const double* y_target = integ_.y();
+    if (integ_.t() != target) {
+      if (!integ_.state_at(target, y_out_.data())) {
+        record_failure(result_,
+                       integ_.failure_reason().empty() ? "cannot reach output time" : integ_.failure_reason(),
+                       integ_.t());
+        return false;
+      }
+      y_target = y_out_.data();
+    }
+    const bool output = target == cfg_.t_end || std::binary_search(output_times_.begin(), output_times_.end(), target);
+    if (!recorder_.observe(target, y_target, output, cfg_.blowup)) return false;
+    if (target == result_.ref_time) {
+      result_.state_at_ref = recorder_.canonical();
+      double err = 0;
+      for (size_t i = 0; i < result_.ref_state.size(); ++i)
+        if (!std::isnan(result_.ref_state[i]))
+          err = std::max(err, std::abs(result_.state_at_ref[i] - result_.ref_state[i]));
+      result_.ref_error = err;
+      result_.ref_scd = significant_digits(result_.state_at_ref, result_.ref_state);
+    }
+    if (target == cfg_.t_end) result_.final_state = recorder_.canonical();
+    return true;
+  }
+
+  const RunConfig& cfg_;
+  Formulation& form_;
+  Integrator& integ_;
+  Recorder& recorder_;
+  RunResult& result_;
+  std::vector<double> targets_, output_times_, y_out_;
+  long since_observed_ = 0;
+};
+
+}  // namespace
+
+RunResult run_case(const Problem& registered, const RunConfig& cfg, const std::string& out_dir) {
+  // ---- validate everything before any file is created ----
+  std::string problem_params;
+  const std::unique_ptr<Problem> variant = problem_variant(registered, cfg.problem_params, &problem_params);
+  const Problem& problem = variant ? *variant : registered;
+  const IntegratorInfo& integ_info = find_integrator(cfg.integrator);
+  check_run_settings(cfg, integ_info);
+  Params params;
+  auto form = make_checked_formulation(problem, cfg, integ_info, &params);
+  auto integrator = make_integrator(cfg.integrator, cfg.step);
+  form->set_step_hint(integ_info.fixed_step ? cfg.step.step : 0.0);
+  RunResult result;
+  start_result(result, problem, cfg, *form, params, problem_params);
   RunOutputs outputs(out_dir, cfg.write_series);
 
   // ---- integrate ----
   const int n = form->dimension();
-  std::vector<double> y0(n), y_out(n);
+  std::vector<double> y0(n);
   form->initial_state(y0.data());
   if (cfg.perturb > 0) perturb_initial_state(cfg.perturb, n, y0.data());
   const double sample_every = cfg.sample_every > 0 ? cfg.sample_every : cfg.t_end / 1000;
   Recorder recorder(problem, *form, result, outputs.series(), sample_every, cfg.drift_fit_from, cfg.t_end);
-
-  std::vector<double> targets = cfg.times;
-  if (ref_time > 0) targets.push_back(ref_time);
-  targets.push_back(cfg.t_end);
-  std::sort(targets.begin(), targets.end());
-  targets.erase(std::unique(targets.begin(), targets.end()), targets.end());
-  std::vector<double> output_times = cfg.times;  // sorted: a lookup per target stays O(log n)
-  std::sort(output_times.begin(), output_times.end());
-  auto is_output_time = [&](double t) {
-    return t == cfg.t_end || std::binary_search(output_times.begin(), output_times.end(), t);
-  };
-
+  RunLoop loop(cfg, *form, *integrator, recorder, result);
   const auto start = RunClock::now();
-  integrator->start(*form, 0.0, y0.data());
-  bool alive = recorder.observe(0.0, y0.data(), true, cfg.blowup);
-  long since_observed = 0;
-  for (double target : targets) {
-    if (!alive) break;
-    while (alive && integrator->t() < target) {
-      if (double(integrator->steps()) >= cfg.max_steps) {
-        result.status = "failed";
-        result.reason = "step limit: " + format_short(cfg.max_steps) + " steps taken by t = " +
-                        format_short(integrator->t()) + " (--max-steps raises it)";
-        result.fail_time = integrator->t();
-        alive = false;
-        break;
-      }
-      const StepOutcome outcome = integrator->step(target);
-      if (outcome == StepOutcome::kPastLimit) break;
-      if (outcome == StepOutcome::kFailed) {
-        result.status = "failed";
-        result.reason = integrator->failure_reason();
-        result.fail_time = integrator->t();
-        alive = false;
-        break;
-      }
-      if (form->has_post_step() && !integrator->applies_post_step() &&
-          form->post_step(integrator->t(), integrator->y())) {
-        if (!integrator->notify_modified()) {
-          result.status = "failed";
-          result.reason = integrator->failure_reason();
-          result.fail_time = integrator->t();
-          alive = false;
-          break;
-        }
-      }
-      // A step that reaches the target is observed just below, once.
-      if (integrator->t() < target &&
-          (++since_observed >= cfg.observe_every || recorder.due_for_sample(integrator->t()))) {
-        since_observed = 0;
-        alive = recorder.observe(integrator->t(), integrator->y(), false, cfg.blowup);
-      }
-    }
-    if (!alive) break;
-    // The exact state at `target`.
-    const double* y_target = integrator->y();
-    if (integrator->t() != target) {
-      if (!integrator->state_at(target, y_out.data())) {
-        result.status = "failed";
-        result.reason = integrator->failure_reason().empty() ? "cannot reach output time"
-                                                              : integrator->failure_reason();
-        result.fail_time = integrator->t();
-        break;
-      }
-      y_target = y_out.data();
-    }
-    alive = recorder.observe(target, y_target, is_output_time(target), cfg.blowup);
-    if (!alive) break;
-    if (target == ref_time) {
-      result.state_at_ref = recorder.canonical();
-      double err = 0;
-      for (size_t i = 0; i < result.ref_state.size(); ++i)
-        if (!std::isnan(result.ref_state[i])) err = std::max(err, std::abs(result.state_at_ref[i] - result.ref_state[i]));
-      result.ref_error = err;
-      result.ref_scd = significant_digits(result.state_at_ref, result.ref_state);
-    }
-    if (target == cfg.t_end) result.final_state = recorder.canonical();
-  }
+  loop.run(y0.data());
   result.wall_seconds = std::max(0.0, seconds_since(start) - result.observe_seconds);
   if (result.status != "ok") result.recovery_time = std::numeric_limits<double>::quiet_NaN();
   recorder.fit_drift_growth();
