@@ -2,7 +2,7 @@
 # Installs the Debian 12 packages cstab needs (plus any given as arguments), only those missing.
 set -euo pipefail
 packages=(g++ cmake make libeigen3-dev libsundials-dev libgsl-dev libbenchmark-dev libfccp-dev libtomlplusplus-dev
-          gnuplot-nox googletest libgtest-dev libcli11-dev zlib1g-dev parallel
+          gnuplot-nox googletest libgtest-dev libcli11-dev zlib1g-dev parallel lld
           libsimbody-dev libmujoco-dev "$@")
 missing=()
 for p in "${packages[@]}"; do
