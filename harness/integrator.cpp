@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdlib>
 #include <cstring>
 
 #include "core/format.hpp"
@@ -343,13 +344,29 @@ class GslAdaptive final : public Integrator {
     return self->eval(t, y, dydt) ? GSL_SUCCESS : GSL_EBADFUNC;
   }
 
-  // Forward-difference Jacobian for the implicit BDF scheme.
+  // Forward-difference Jacobian for the implicit BDF scheme. For diagnosis,
+  // CSTAB_MSBDF_CENTRAL_JACOBIAN=1 in the environment makes it central
+  // differences (error O(d^2) instead of O(d)): docs/measurements.md uses it
+  // to show that msbdf's cost at high gains does not come from the
+  // Jacobian's accuracy.
   static int gsl_jac(double t, const double y[], double* dfdy, double dfdt[], void* self_ptr) {
     auto* self = static_cast<GslAdaptive*>(self_ptr);
     const int n = self->n_;
     if (!self->eval(t, y, self->fd_f0_.data())) return GSL_EBADFUNC;
     std::copy(y, y + n, self->fd_y_.begin());
+    static const bool central = std::getenv("CSTAB_MSBDF_CENTRAL_JACOBIAN") != nullptr;
     for (int j = 0; j < n; ++j) {
+      if (central) {
+        const double dy = std::cbrt(2.2e-16) * std::max(1.0, std::abs(y[j]));
+        self->fd_y_[j] = y[j] + dy;
+        if (!self->eval(t, self->fd_y_.data(), self->fd_f1_.data())) return GSL_EBADFUNC;
+        for (int i = 0; i < n; ++i) dfdy[i * n + j] = self->fd_f1_[i];
+        self->fd_y_[j] = y[j] - dy;
+        if (!self->eval(t, self->fd_y_.data(), self->fd_f1_.data())) return GSL_EBADFUNC;
+        for (int i = 0; i < n; ++i) dfdy[i * n + j] = (dfdy[i * n + j] - self->fd_f1_[i]) / (2 * dy);
+        self->fd_y_[j] = y[j];
+        continue;
+      }
       const double dy = std::sqrt(2.2e-16) * std::max(1.0, std::abs(y[j]));
       self->fd_y_[j] = y[j] + dy;
       if (!self->eval(t, self->fd_y_.data(), self->fd_f1_.data())) return GSL_EBADFUNC;
