@@ -63,7 +63,7 @@
 
 #include "core/format.hpp"
 #include "linalg/dense.hpp"
-#include "methods/ida.hpp"
+#include "methods/consistent_start.hpp"
 #include "methods/mechanical_method.hpp"
 #include "methods/newton_terms.hpp"
 
@@ -92,7 +92,7 @@ class Ali3pFormulation final : public SelfSteppingFormulation<Model> {
 
   void initial_state(double* y) const override {
     VecQ q, v;
-    MechanicalDaeFormulation<Model, false>(this->model_, method_).consistent_state(0.0, q, v);
+    ConsistentStart<Model>::state(this->model_, 0.0, q, v);
     MechanicalTerms<Model> terms;
     terms.evaluate(this->model_, 0.0, q, v, false);
     VecQ a = VecQ::Zero();

@@ -48,7 +48,7 @@
 // State: y = [q; v; a; vdot; lambda; nu] (a: pseudo-acceleration, vdot:
 // acceleration, nu only for index 2), so the observables read [q; v] as for
 // every mechanical method. Start: q, v made consistent like the DAE methods
-// (MechanicalDaeFormulation::initial_values), vdot and lambda from the KKT
+// (ConsistentStart, methods/consistent_start.hpp), vdot and lambda from the KKT
 // system at t0, a = vdot; `--param consistent_start=0` starts from
 // a = vdot = 0, lambda = 0 instead (Arnold & Bruls' order-reduction example).
 #pragma once
@@ -61,7 +61,7 @@
 
 #include "core/format.hpp"
 #include "linalg/dense.hpp"
-#include "methods/ida.hpp"
+#include "methods/consistent_start.hpp"
 #include "methods/mechanical_method.hpp"
 #include "methods/newton_terms.hpp"
 
@@ -115,17 +115,17 @@ class GeneralizedAlphaFormulation final : public SelfSteppingFormulation<Model> 
   int dimension() const override { return kDim; }
 
   void initial_state(double* y) const override {
-    MechanicalDaeFormulation<Model, false> dae(this->model_, method_);
-    constexpr int nd = 2 * nq + nc;
-    Vec<double, nd> yd, ypd;
-    dae.initial_values(0.0, yd.data(), ypd.data());
+    VecQ q, v;
+    ConsistentStart<Model>::state(this->model_, 0.0, q, v);
+    Vec<double, nq + nc> x;  // (a, lambda) from the KKT system
+    ConsistentStart<Model>::accelerations(this->model_, 0.0, q, v, x);
     for (int i = 0; i < kDim; ++i) y[i] = 0;
-    vmap<nq>(y) = yd.template head<nq>();
-    vmap<nq>(y + nq) = yd.template segment<nq>(nq);
+    vmap<nq>(y) = q;
+    vmap<nq>(y + nq) = v;
     if (settings_.consistent_start) {
-      vmap<nq>(y + kA) = ypd.template segment<nq>(nq);
-      vmap<nq>(y + kVdot) = ypd.template segment<nq>(nq);
-      if constexpr (nc > 0) vmap<nc>(y + kLambda) = yd.template tail<nc>();
+      vmap<nq>(y + kA) = x.template head<nq>();
+      vmap<nq>(y + kVdot) = x.template head<nq>();
+      if constexpr (nc > 0) vmap<nc>(y + kLambda) = x.template tail<nc>();
     }
   }
 

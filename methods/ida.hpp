@@ -30,9 +30,8 @@
 
 #include <cmath>
 
+#include "methods/consistent_start.hpp"
 #include "methods/mechanical_method.hpp"
-#include "linalg/dense.hpp"
-#include "linalg/weighted_pinv.hpp"
 
 namespace cstab {
 
@@ -63,101 +62,20 @@ class MechanicalDaeFormulation final : public MechanicalFormulationBase<Model>, 
     initial_values(0.0, y, yp.data());
   }
 
-  // q, v from the model (made consistent, see consistent_state); a and
+  // q, v from the model (made consistent, ConsistentStart::state); a and
   // lambda from the KKT system (the acceleration level, exact for consistent
   // q, v); mu = 0, lambda' = mu' = 0.
   void initial_values(double t0, double* y, double* yp) const override {
     VecQ q, v;
-    consistent_state(t0, q, v);
-    MechanicalTerms<Model> terms;
-    terms.evaluate(this->model_, t0, q, v, false);
-    Eigen::Matrix<double, nk, nk> K = Eigen::Matrix<double, nk, nk>::Zero();
-    Vec<double, nk> b;
-    K.template topLeftCorner<nq, nq>() = terms.M;
-    b.template head<nq>() = terms.Q;
-    if constexpr (nc > 0) {
-      K.template topRightCorner<nq, nc>() = -terms.A.transpose();
-      K.template bottomLeftCorner<nc, nq>() = terms.A;
-      b.template tail<nc>() = -terms.gamma;
-    }
-    // The solve stays fixed-size (its result seeds IDA, whose step sequence
-    // is sensitive to the last bit); the condition estimate is the cold
-    // dynamic-size one.
-    const Eigen::PartialPivLU<Eigen::Matrix<double, nk, nk>> lu(K);
-    Vec<double, nk> x = lu.solve(b);
-    if (!(linalg::lu_rcond_of(K) > 1e-15) || !x.allFinite()) {
-      // Leave the multipliers to IDACalcIC.
-      x.setZero();
-      linalg::ldlt_solve(terms.M.data(), nq, terms.Q.data(), x.data());
-    }
+    ConsistentStart<Model>::state(this->model_, t0, q, v);
+    Vec<double, nk> x;
+    ConsistentStart<Model>::accelerations(this->model_, t0, q, v, x);
     for (int i = 0; i < kDim; ++i) y[i] = yp[i] = 0;
     vmap<nq>(y) = q;
     vmap<nq>(y + nq) = v;
     vmap<nq>(yp) = v;
     vmap<nq>(yp + nq) = x.template head<nq>();
     if constexpr (nc > 0) vmap<nc>(y + kLambda) = x.template tail<nc>();
-  }
-
-  // The problem's q(0), v(0), moved onto the constraints if they violate
-  // them (some problems' published initial data do): GGL has no solution
-  // through an inconsistent point, IDACalcIC never changes differential
-  // components, and index 1 would carry the violation along unchanged.
-  // Positions follow the correction flow
-  //     dq/dtau = -M^-1 J^T (J M^-1 J^T)^-1 Phi(t0, q)   (Phi decays like e^-tau)
-  // to its end point, the limit every stabilization's transient tends to
-  // (RK4 in tau, then Gauss-Newton to polish; a single Gauss-Newton
-  // projection lands elsewhere on the manifold, by 1.8e-5 on the biped's
-  // 4.9e-3 m inconsistency). Velocities then take the least change in the
-  // mass norm (affine constraints: one correction). Consistent data are left
-  // untouched.
-  void consistent_state(double t0, VecQ& q, VecQ& v) const {
-    this->model_.initial_state(q, v);
-    if constexpr (nc > 0) {
-      constexpr double kTol = 1e-14;
-      MechanicalTerms<Model> terms;
-      Eigen::Matrix<double, nq, nq> M;
-      if constexpr (nh > 0) {
-        MassFactor<nq> mass;
-        WeightedPinv<nh, nq> pinv;
-        // -dq/dtau at q; false if M is singular.
-        auto flow = [&](const VecQ& at, VecQ& direction) {
-          terms.evaluate_position(this->model_, t0, at);
-          this->model_.mass(t0, at, M);
-          if (!mass.factor(M)) return false;
-          pinv.set_rows(mass, terms.A.template topRows<nh>());
-          direction = pinv.correction(terms.phi);
-          return true;
-        };
-        terms.evaluate_position(this->model_, t0, q);
-        if (terms.phi.template lpNorm<Eigen::Infinity>() > kTol) {
-          constexpr double kDtau = 0.25, kTauEnd = 30;  // e^-30 ~ 1e-13
-          VecQ k1, k2, k3, k4;
-          for (double tau = 0; tau < kTauEnd; tau += kDtau) {
-            if (!flow(q, k1) || !flow(q - 0.5 * kDtau * k1, k2) || !flow(q - 0.5 * kDtau * k2, k3) ||
-                !flow(q - kDtau * k3, k4))
-              break;
-            q -= kDtau / 6 * (k1 + 2 * k2 + 2 * k3 + k4);
-          }
-          for (int it = 0; it < 5; ++it) {
-            terms.evaluate_position(this->model_, t0, q);
-            if (terms.phi.template lpNorm<Eigen::Infinity>() <= kTol) break;
-            VecQ step;
-            if (!flow(q, step)) break;
-            q -= step;
-          }
-        }
-      }
-      terms.evaluate_velocity(this->model_, t0, q, v);
-      if (terms.velocity.template lpNorm<Eigen::Infinity>() > kTol) {
-        this->model_.mass(t0, q, M);
-        MassFactor<nq> velocity_mass;
-        WeightedPinv<nc, nq> velocity_pinv;
-        if (velocity_mass.factor(M)) {
-          velocity_pinv.set_rows(velocity_mass, terms.A);
-          v -= velocity_pinv.correction(terms.velocity);
-        }
-      }
-    }
   }
 
   // GGL is index 2: the integrator checks its initial values instead of

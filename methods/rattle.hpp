@@ -42,8 +42,8 @@
 
 #include "core/format.hpp"
 #include "linalg/dense.hpp"
+#include "methods/consistent_start.hpp"
 #include "methods/contracts.hpp"
-#include "methods/ida.hpp"
 #include "methods/mechanical_method.hpp"
 #include "methods/newton_terms.hpp"
 
@@ -89,7 +89,7 @@ class RattleFormulation final : public SelfSteppingFormulation<Model> {
 
   void initial_state(double* y) const override {
     VecQ q, v;
-    MechanicalDaeFormulation<Model, false>(this->model_, method_).consistent_state(0.0, q, v);
+    ConsistentStart<Model>::state(this->model_, 0.0, q, v);
     vmap<nq>(y) = q;
     vmap<nq>(y + nq) = v;
   }
