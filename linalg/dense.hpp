@@ -64,4 +64,28 @@ class Cod {
   std::unique_ptr<Impl> impl_;
 };
 
+// Partial-pivoting LU of an n x n matrix, for the Newton iterations of the
+// implicit schemes (generalized-alpha and its kin, ali3p): compiled once for
+// every size, where Eigen's fixed-size PartialPivLU is compiled again for
+// each size in every method's pair unit. Storage is allocated at
+// construction; compute() and solve() do not allocate. A singular matrix
+// gives a non-finite solution.
+class Lu {
+ public:
+  explicit Lu(int n);
+  ~Lu();
+  Lu(const Lu&) = delete;
+  Lu& operator=(const Lu&) = delete;
+  Lu(Lu&&) noexcept;
+  Lu& operator=(Lu&&) noexcept;
+
+  void compute(const double* a);                 // column-major n x n
+  void solve(const double* b, double* x) const;  // x = A^-1 b; x may alias b
+  int size() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
 }  // namespace cstab::linalg

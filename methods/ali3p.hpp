@@ -102,16 +102,21 @@ class Ali3pFormulation final : public SelfSteppingFormulation<Model> {
       // (M + p A^T A) a = Q + A^T lambda - p A^T gamma, lambda -= p (A a + gamma).
       const MatQ AtA = terms.A.transpose() * terms.A;
       const double p = 1e3 * terms.M.diagonal().cwiseAbs().maxCoeff() / std::max(AtA.diagonal().maxCoeff(), 1e-300);
-      const Eigen::PartialPivLU<MatQ> lu(MatQ(terms.M + p * AtA));
+      const MatQ W = terms.M + p * AtA;
+      linalg::Lu lu(nq);
+      lu.compute(W.data());
       for (int it = 0; it < 200; ++it) {
-        a = lu.solve(VecQ(terms.Q + terms.A.transpose() * lambda - p * terms.A.transpose() * terms.gamma));
+        const VecQ rhs = terms.Q + terms.A.transpose() * lambda - p * terms.A.transpose() * terms.gamma;
+        lu.solve(rhs.data(), a.data());
         const VecC viol = terms.A * a + terms.gamma;
         lambda -= p * viol;
         if (viol.template lpNorm<Eigen::Infinity>() <= 1e-15 * (1 + terms.gamma.template lpNorm<Eigen::Infinity>()))
           break;
       }
     } else {
-      a = Eigen::PartialPivLU<MatQ>(terms.M).solve(terms.Q);
+      linalg::Lu lu(nq);
+      lu.compute(terms.M.data());
+      lu.solve(terms.Q.data(), a.data());
     }
     for (int i = 0; i < kDim; ++i) y[i] = 0;
     vmap<nq>(y) = q;
@@ -151,8 +156,9 @@ class Ali3pFormulation final : public SelfSteppingFormulation<Model> {
       const double p = iteration_matrix(h);
       VecQ f = terms_.r;
       if constexpr (nc > 0) f += p * terms_.A.transpose() * penalty_rows(terms_.phi, terms_.vel, h);
-      lu_.compute(W_);
-      const VecQ dq = lu_.solve(VecQ(-h2 * f));
+      lu_.compute(W_.data());
+      VecQ dq = -h2 * f;
+      lu_.solve(dq.data(), dq.data());
       if (!dq.allFinite()) break;
       q += dq;
       correction = dq.template lpNorm<Eigen::Infinity>() / (1 + q.template lpNorm<Eigen::Infinity>());
@@ -180,10 +186,13 @@ class Ali3pFormulation final : public SelfSteppingFormulation<Model> {
     if constexpr (nc > 0) {
       // Mass-orthogonal projections with the last factorization of W.
       projection_terms_.evaluate_velocity(this->model_, t1, q, v);
-      v += lu_.solve(VecQ(-h2 * p_ * projection_terms_.A.transpose() * projection_terms_.velocity));
+      VecQ dv = -h2 * p_ * projection_terms_.A.transpose() * projection_terms_.velocity;
+      lu_.solve(dv.data(), dv.data());
+      v += dv;
       projection_terms_.evaluate(this->model_, t1, q, v, false);
-      a += lu_.solve(VecQ(-h2 * p_ * projection_terms_.A.transpose() *
-                          (projection_terms_.A * a + projection_terms_.gamma)));
+      VecQ da = -h2 * p_ * projection_terms_.A.transpose() * (projection_terms_.A * a + projection_terms_.gamma);
+      lu_.solve(da.data(), da.data());
+      a += da;
     }
     vmap<nq>(y) = q;
     vmap<nq>(y + nq) = v;
@@ -238,7 +247,7 @@ class Ali3pFormulation final : public SelfSteppingFormulation<Model> {
   MechanicalTerms<Model> projection_terms_;
   MatQ W_, AtA_;
   double p_ = 0;  // the penalty of the last iteration matrix
-  Eigen::PartialPivLU<MatQ> lu_;
+  linalg::Lu lu_{nq};  // dynamic-size, compiled once (linalg/dense.cpp)
 };
 
 struct Ali3pMethod : MechanicalMethod<Ali3pMethod> {

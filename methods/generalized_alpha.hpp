@@ -182,8 +182,8 @@ class GeneralizedAlphaFormulation final : public SelfSteppingFormulation<Model> 
       ++it;
       evaluate(t1, q, v, vdot, lambda);
       assemble(h, S_, b_);
-      lu_.compute(S_);
-      x_ = lu_.solve(b_);
+      lu_.compute(S_.data());
+      lu_.solve(b_.data(), x_.data());
       if (!x_.allFinite()) break;
       const VecQ dw = x_.template head<nq>();
       w += dw;
@@ -272,7 +272,7 @@ class GeneralizedAlphaFormulation final : public SelfSteppingFormulation<Model> 
   NewtonTerms<Model> terms_;
   MatN S_;
   VecN b_, x_;
-  Eigen::PartialPivLU<MatN> lu_;
+  linalg::Lu lu_{kN};  // dynamic-size, compiled once (linalg/dense.cpp)
 };
 
 // Parameters shared by the three methods.

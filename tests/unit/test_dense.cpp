@@ -75,5 +75,63 @@ TEST(Cod, ZeroMatrixGivesZero) {
   for (double xi : x) EXPECT_EQ(xi, 0.0);
 }
 
+// The residual of the solve, relative: ||A x - b|| / (||A|| ||x|| + ||b||).
+double relative_residual(const Eigen::MatrixXd& a, const Eigen::VectorXd& x, const Eigen::VectorXd& b) {
+  return (a * x - b).norm() / (a.norm() * x.norm() + b.norm());
+}
+
+TEST(Lu, SolvesAgainstAClosedFormInverse) {
+  // [[2, 1], [1, 1]]^-1 = [[1, -1], [-1, 2]]: x = (1*3 - 1*5, -3 + 2*5) = (-2, 7).
+  const double a[4] = {2, 1, 1, 1};  // column-major
+  linalg::Lu lu(2);
+  EXPECT_EQ(lu.size(), 2);
+  lu.compute(a);
+  const double b[2] = {3, 5};
+  double x[2];
+  lu.solve(b, x);
+  EXPECT_NEAR(x[0], -2, 1e-15);
+  EXPECT_NEAR(x[1], 7, 1e-15);
+}
+
+TEST(Lu, NeedsPivotingAndMatchesFullPivotingLu) {
+  // A zero leading entry: no LU without row exchanges exists.
+  Eigen::MatrixXd a(3, 3);
+  a << 0, 2, 1, 1, 0, 3, 4, 1, 0;
+  const Eigen::VectorXd b = Eigen::Vector3d(1, -2, 5);
+  linalg::Lu lu(3);
+  lu.compute(a.data());
+  Eigen::VectorXd x(3);
+  lu.solve(b.data(), x.data());
+  const Eigen::VectorXd expected = a.fullPivLu().solve(b);
+  EXPECT_LT((x - expected).norm(), 1e-14 * expected.norm());
+}
+
+TEST(Lu, RefactorsAndSolvesInPlaceAtKktSizes) {
+  // A KKT-like system [M -A^T; A 0], the shape the Newton iterations solve,
+  // refactored twice with one object; x aliasing b gives the same answer.
+  std::srand(11);
+  for (int n : {5, 21, 40}) {
+    linalg::Lu lu(n);
+    for (int round = 0; round < 2; ++round) {
+      const int nq = 2 * n / 3, nc = n - nq;
+      Eigen::MatrixXd m = Eigen::MatrixXd::Random(nq, nq);
+      m = m * m.transpose() + Eigen::MatrixXd::Identity(nq, nq);
+      const Eigen::MatrixXd c = Eigen::MatrixXd::Random(nc, nq);
+      Eigen::MatrixXd k = Eigen::MatrixXd::Zero(n, n);
+      k.topLeftCorner(nq, nq) = m;
+      k.topRightCorner(nq, nc) = -c.transpose();
+      k.bottomLeftCorner(nc, nq) = c;
+      const Eigen::VectorXd b = Eigen::VectorXd::Random(n);
+      lu.compute(k.data());
+      Eigen::VectorXd x(n);
+      lu.solve(b.data(), x.data());
+      EXPECT_LT(relative_residual(k, x, b), 1e-14) << "n = " << n;
+      Eigen::VectorXd inplace = b;
+      lu.solve(inplace.data(), inplace.data());
+      EXPECT_EQ((inplace - x).norm(), 0.0) << "n = " << n;
+    }
+  }
+}
+
 }  // namespace
 }  // namespace cstab
