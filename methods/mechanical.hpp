@@ -129,8 +129,8 @@ struct MechanicalTerms : MechanicalSizes<Model> {
   }
 
   // The evaluations are defined below the class, out of line: a problem
-  // instantiates them once for its model (`template struct
-  // MechanicalTerms<Model>;` in its .cpp, `extern template` in its header),
+  // instantiates them once for its model (cstab_model in its CMakeLists.txt,
+  // CSTAB_EXTERN_MODEL_TEMPLATES in its header: methods/model_templates.hpp),
   // and the method units that include the header reuse that instance instead
   // of compiling the AD evaluations again (docs/build.md).
 

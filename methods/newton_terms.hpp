@@ -81,8 +81,9 @@ struct NewtonTerms : MechanicalSizes<Model> {
   void evaluate(const Model& model, double t, const VecQ& q, const VecQ& v, const VecQ& vdot,
                 const Vec<double, nc>& lambda);
   // Defined below, out of line: a problem instantiates it once for its model
-  // (`template struct NewtonTerms<Model>;` in its .cpp, `extern template` in
-  // its header), as for MechanicalTerms (docs/build.md).
+  // (cstab_model in its CMakeLists.txt, CSTAB_EXTERN_MODEL_TEMPLATES in its
+  // header: methods/model_templates.hpp), as for MechanicalTerms
+  // (docs/build.md).
 };
 
 template <class Model>

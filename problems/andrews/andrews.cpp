@@ -80,8 +80,4 @@ bool Andrews::reference(double t, double* canonical) const {
   return true;
 }
 
-// The model's AD evaluations, instantiated once (extern in the header).
-template struct MechanicalTerms<AndrewsMechanical>;
-template struct NewtonTerms<AndrewsMechanical>;
-
 }  // namespace cstab

@@ -31,7 +31,7 @@
 #include "core/problem.hpp"
 #include "methods/affine.hpp"
 #include "methods/mechanical.hpp"
-#include "methods/newton_terms.hpp"
+#include "methods/model_templates.hpp"
 #include "problems/common/trig_rows.hpp"
 
 namespace cstab {
@@ -212,8 +212,7 @@ class Andrews {
   AndrewsMechanical mechanical_;
 };
 
-// Compiled once, in andrews.cpp; the method units reuse it.
-extern template struct MechanicalTerms<AndrewsMechanical>;
-extern template struct NewtonTerms<AndrewsMechanical>;
+// Compiled once (cstab_model in CMakeLists.txt); the method units reuse it.
+CSTAB_EXTERN_MODEL_TEMPLATES(AndrewsMechanical);
 
 }  // namespace cstab

@@ -1,6 +1,5 @@
 #include "problems/ball/ball.hpp"
 
-
 namespace cstab {
 
 namespace {
@@ -211,9 +210,5 @@ void Ball::first_integrals(double, const double* c, double* out) const {
 }
 
 bool Ball::reference(double t, double* canonical) const { return reference_.at(t, canonical); }
-
-// The model's AD evaluations, instantiated once (extern in the header).
-template struct MechanicalTerms<BallMechanical>;
-template struct NewtonTerms<BallMechanical>;
 
 }  // namespace cstab

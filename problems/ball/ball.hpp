@@ -62,10 +62,10 @@
 #include "core/autodiff.hpp"
 #include "core/formulation.hpp"
 #include "core/problem.hpp"
-#include "problems/common/reference_cache.hpp"
 #include "methods/affine.hpp"
 #include "methods/mechanical.hpp"
-#include "methods/newton_terms.hpp"
+#include "methods/model_templates.hpp"
+#include "problems/common/reference_cache.hpp"
 
 namespace cstab {
 
@@ -313,8 +313,7 @@ class Ball {
   ReferenceCache reference_ = reference_cache_of(minimal_, 24);
 };
 
-// Compiled once, in ball.cpp; the method units reuse it.
-extern template struct MechanicalTerms<BallMechanical>;
-extern template struct NewtonTerms<BallMechanical>;
+// Compiled once (cstab_model in CMakeLists.txt); the method units reuse it.
+CSTAB_EXTERN_MODEL_TEMPLATES(BallMechanical);
 
 }  // namespace cstab

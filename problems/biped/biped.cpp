@@ -314,8 +314,4 @@ ProblemInfo Biped::info() const {
   return info;
 }
 
-// The model's AD evaluations, instantiated once (extern in the header).
-template struct MechanicalTerms<BipedMechanical>;
-template struct NewtonTerms<BipedMechanical>;
-
 }  // namespace cstab

@@ -122,7 +122,7 @@
 #include "core/problem.hpp"
 #include "methods/affine.hpp"
 #include "methods/mechanical.hpp"
-#include "methods/newton_terms.hpp"
+#include "methods/model_templates.hpp"
 
 namespace cstab {
 
@@ -348,8 +348,7 @@ class Biped {
   Vec<double, 2> x_ref_;
 };
 
-// Compiled once, in biped.cpp; the method units reuse it.
-extern template struct MechanicalTerms<BipedMechanical>;
-extern template struct NewtonTerms<BipedMechanical>;
+// Compiled once (cstab_model in CMakeLists.txt); the method units reuse it.
+CSTAB_EXTERN_MODEL_TEMPLATES(BipedMechanical);
 
 }  // namespace cstab

@@ -196,7 +196,4 @@ double Bricard::energy(double, const double* c) const {
 
 bool Bricard::reference(double t, double* canonical) const { return reference_.at(t, canonical); }
 
-template struct MechanicalTerms<BricardMechanical>;
-template struct NewtonTerms<BricardMechanical>;
-
 }  // namespace cstab

@@ -47,7 +47,7 @@
 #include "core/problem.hpp"
 #include "core/vec.hpp"
 #include "methods/mechanical.hpp"
-#include "methods/newton_terms.hpp"
+#include "methods/model_templates.hpp"
 #include "problems/common/reference_cache.hpp"
 
 namespace cstab {
@@ -181,7 +181,7 @@ class Bricard {
   ReferenceCache reference_ = reference_cache_of(minimal_, 24);
 };
 
-extern template struct MechanicalTerms<BricardMechanical>;
-extern template struct NewtonTerms<BricardMechanical>;
+// Compiled once (cstab_model in CMakeLists.txt); the method units reuse it.
+CSTAB_EXTERN_MODEL_TEMPLATES(BricardMechanical);
 
 }  // namespace cstab

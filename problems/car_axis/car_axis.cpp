@@ -36,8 +36,4 @@ bool CarAxis::reference(double t, double* canonical) const {
   return true;
 }
 
-// The model's AD evaluations, instantiated once (extern in the header).
-template struct MechanicalTerms<CarAxisMechanical>;
-template struct NewtonTerms<CarAxisMechanical>;
-
 }  // namespace cstab

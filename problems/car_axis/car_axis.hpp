@@ -26,7 +26,7 @@
 #include "core/problem.hpp"
 #include "methods/affine.hpp"
 #include "methods/mechanical.hpp"
-#include "methods/newton_terms.hpp"
+#include "methods/model_templates.hpp"
 
 namespace cstab {
 
@@ -136,8 +136,7 @@ class CarAxis {
   CarAxisMechanical mechanical_;
 };
 
-// Compiled once, in car_axis.cpp; the method units reuse it.
-extern template struct MechanicalTerms<CarAxisMechanical>;
-extern template struct NewtonTerms<CarAxisMechanical>;
+// Compiled once (cstab_model in CMakeLists.txt); the method units reuse it.
+CSTAB_EXTERN_MODEL_TEMPLATES(CarAxisMechanical);
 
 }  // namespace cstab

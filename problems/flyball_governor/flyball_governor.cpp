@@ -190,7 +190,4 @@ void FlyballGovernor::first_integrals(double, const double* c, double* out) cons
 
 bool FlyballGovernor::reference(double t, double* canonical) const { return reference_.at(t, canonical); }
 
-template struct MechanicalTerms<FlyballMechanical>;
-template struct NewtonTerms<FlyballMechanical>;
-
 }  // namespace cstab

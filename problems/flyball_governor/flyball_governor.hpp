@@ -59,7 +59,7 @@
 #include "core/problem.hpp"
 #include "core/vec.hpp"
 #include "methods/mechanical.hpp"
-#include "methods/newton_terms.hpp"
+#include "methods/model_templates.hpp"
 #include "problems/common/reference_cache.hpp"
 
 namespace cstab {
@@ -195,7 +195,7 @@ class FlyballGovernor {
   ReferenceCache reference_ = reference_cache_of(minimal_, 18);
 };
 
-extern template struct MechanicalTerms<FlyballMechanical>;
-extern template struct NewtonTerms<FlyballMechanical>;
+// Compiled once (cstab_model in CMakeLists.txt); the method units reuse it.
+CSTAB_EXTERN_MODEL_TEMPLATES(FlyballMechanical);
 
 }  // namespace cstab

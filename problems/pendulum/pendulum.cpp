@@ -85,8 +85,4 @@ double Pendulum::period() const {
   return 4 * std::sqrt(p_.L / p_.g) * gsl_sf_ellint_Kcomp(k, GSL_PREC_DOUBLE);
 }
 
-// The model's AD evaluations, instantiated once (extern in the header).
-template struct MechanicalTerms<PendulumMechanical>;
-template struct NewtonTerms<PendulumMechanical>;
-
 }  // namespace cstab

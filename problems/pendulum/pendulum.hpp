@@ -26,7 +26,7 @@
 #include "core/problem.hpp"
 #include "core/vec.hpp"
 #include "methods/mechanical.hpp"
-#include "methods/newton_terms.hpp"
+#include "methods/model_templates.hpp"
 #include "problems/common/reference_cache.hpp"
 
 namespace cstab {
@@ -121,8 +121,7 @@ class Pendulum {
   ReferenceCache reference_ = reference_cache_of(minimal_, 4);
 };
 
-// Compiled once, in pendulum.cpp; the method units reuse it.
-extern template struct MechanicalTerms<PendulumMechanical>;
-extern template struct NewtonTerms<PendulumMechanical>;
+// Compiled once (cstab_model in CMakeLists.txt); the method units reuse it.
+CSTAB_EXTERN_MODEL_TEMPLATES(PendulumMechanical);
 
 }  // namespace cstab

@@ -1,6 +1,5 @@
 #include "problems/slider_crank/slider_crank.hpp"
 
-
 namespace cstab {
 
 void SliderCrankMechanical::initial_state(Vec<double, 3>& q, Vec<double, 3>& v) const {
@@ -120,9 +119,5 @@ ProblemInfo SliderCrank::info() const {
 }
 
 bool SliderCrank::reference(double t, double* canonical) const { return reference_.at(t, canonical); }
-
-// The model's AD evaluations, instantiated once (extern in the header).
-template struct MechanicalTerms<SliderCrankMechanical>;
-template struct NewtonTerms<SliderCrankMechanical>;
 
 }  // namespace cstab

@@ -37,10 +37,10 @@
 #include "core/autodiff.hpp"
 #include "core/formulation.hpp"
 #include "core/problem.hpp"
-#include "problems/common/reference_cache.hpp"
 #include "methods/affine.hpp"
 #include "methods/mechanical.hpp"
-#include "methods/newton_terms.hpp"
+#include "methods/model_templates.hpp"
+#include "problems/common/reference_cache.hpp"
 #include "problems/common/trig_rows.hpp"
 
 namespace cstab {
@@ -166,8 +166,7 @@ class SliderCrank {
   ReferenceCache reference_ = reference_cache_of(minimal_, 6);
 };
 
-// Compiled once, in slider_crank.cpp; the method units reuse it.
-extern template struct MechanicalTerms<SliderCrankMechanical>;
-extern template struct NewtonTerms<SliderCrankMechanical>;
+// Compiled once (cstab_model in CMakeLists.txt); the method units reuse it.
+CSTAB_EXTERN_MODEL_TEMPLATES(SliderCrankMechanical);
 
 }  // namespace cstab

@@ -1,6 +1,5 @@
 #include "problems/wheel/wheel.hpp"
 
-
 #include "core/autodiff.hpp"
 
 namespace cstab {
@@ -208,9 +207,5 @@ double Wheel::energy(double, const double* c) const {
 }
 
 bool Wheel::reference(double t, double* canonical) const { return reference_.at(t, canonical); }
-
-// The model's AD evaluations, instantiated once (extern in the header).
-template struct MechanicalTerms<WheelMechanical>;
-template struct NewtonTerms<WheelMechanical>;
 
 }  // namespace cstab

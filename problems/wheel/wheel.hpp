@@ -24,13 +24,13 @@
 #include <type_traits>
 #include <vector>
 
-#include "core/formulation.hpp"
 #include "core/autodiff.hpp"
+#include "core/formulation.hpp"
 #include "core/problem.hpp"
-#include "problems/common/reference_cache.hpp"
 #include "methods/affine.hpp"
 #include "methods/mechanical.hpp"
-#include "methods/newton_terms.hpp"
+#include "methods/model_templates.hpp"
+#include "problems/common/reference_cache.hpp"
 
 namespace cstab {
 
@@ -391,8 +391,7 @@ class Wheel {
   ReferenceCache reference_ = reference_cache_of(minimal_, 9);
 };
 
-// Compiled once, in wheel.cpp; the method units reuse it.
-extern template struct MechanicalTerms<WheelMechanical>;
-extern template struct NewtonTerms<WheelMechanical>;
+// Compiled once (cstab_model in CMakeLists.txt); the method units reuse it.
+CSTAB_EXTERN_MODEL_TEMPLATES(WheelMechanical);
 
 }  // namespace cstab
