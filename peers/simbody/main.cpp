@@ -2,13 +2,15 @@
 // one of Simbody's integrators at a given accuracy and constraint tolerance,
 // and written as a trajectory `cstab score` reads (docs/peers-simbody.md).
 //
-//   cstab-peer-simbody --problem pendulum|slider-crank [--problem-param k=v[,k=v]]
+//   cstab-peer-simbody --problem pendulum|slider-crank|bricard|andrews
+//       [--problem-param k=v[,k=v]] [--closure redundant|independent]
 //       --integrator rk3|rkmerson|rkfeldberg|verlet|euler|cpodes --accuracy A
 //       [--constraint-tolerance C] [--t-end T] [--every DT] --out FILE.csv
 //
 // The program is deliberately independent of cstab's code: it restates the
 // problems' parameters (problems/pendulum/pendulum.hpp,
-// problems/slider_crank/slider_crank.hpp) the way an outside user would, and
+// problems/slider_crank/slider_crank.hpp, problems/bricard/bricard.hpp,
+// problems/andrews/andrews.hpp) the way an outside user would, and
 // tests/peers/test_simbody.cpp checks that the two agree.
 //
 // Exit codes: 0 done; 1 Simbody failed during integration (the rows up to the
@@ -52,6 +54,7 @@ struct Options {
   std::string problem;
   std::map<std::string, std::string> params;
   std::string integrator;
+  std::string closure;     // bricard only: redundant (default) or independent
   double accuracy = 1e-3;  // Simbody's default accuracy
   double constraint_tolerance = std::nan("");
   double t_end = 10;
@@ -60,8 +63,9 @@ struct Options {
 };
 
 const char* kUsage =
-    "usage: cstab-peer-simbody --problem pendulum|slider-crank [--problem-param k=v[,k=v]] "
+    "usage: cstab-peer-simbody --problem pendulum|slider-crank|bricard|andrews [--problem-param k=v[,k=v]] "
     "--integrator rk3|rkmerson|rkfeldberg|verlet|euler|cpodes [--accuracy A (1e-3)] "
+    "[--closure redundant|independent (bricard; redundant)] "
     "[--constraint-tolerance C (0.1 A)] [--t-end T (10)] [--every DT (0.01)] --out FILE.csv";
 
 Options parse(int argc, char** argv) {
@@ -88,6 +92,8 @@ Options parse(int argc, char** argv) {
       }
     } else if (a == "--integrator") {
       o.integrator = v;
+    } else if (a == "--closure") {
+      o.closure = v;
     } else if (a == "--accuracy") {
       o.accuracy = number(a, v);
       have_accuracy = true;
@@ -104,9 +110,13 @@ Options parse(int argc, char** argv) {
     }
   }
   (void)have_accuracy;
-  if (o.problem.empty()) bad("--problem is required (pendulum or slider-crank)");
-  if (o.problem != "pendulum" && o.problem != "slider-crank")
-    bad("--problem: '" + o.problem + "' is not modelled (pendulum, slider-crank)");
+  if (o.problem.empty()) bad("--problem is required (pendulum, slider-crank, bricard or andrews)");
+  if (o.problem != "pendulum" && o.problem != "slider-crank" && o.problem != "bricard" && o.problem != "andrews")
+    bad("--problem: '" + o.problem + "' is not modelled (pendulum, slider-crank, bricard, andrews)");
+  if (!o.closure.empty() && o.problem != "bricard") bad("--closure: only bricard has a choice of loop closure");
+  if (o.closure.empty() && o.problem == "bricard") o.closure = "redundant";
+  if (o.problem == "bricard" && o.closure != "redundant" && o.closure != "independent")
+    bad("--closure: '" + o.closure + "' is not redundant or independent");
   if (o.integrator.empty()) bad("--integrator is required (rk3, rkmerson, rkfeldberg, verlet, euler, cpodes)");
   static const char* known[] = {"rk3", "rkmerson", "rkfeldberg", "verlet", "euler", "cpodes"};
   bool ok = false;
@@ -243,6 +253,182 @@ struct SliderCrankModel : Model {
   }
 };
 
+// cstab's `bricard` (IFToMM A04, problems/bricard/bricard.hpp): five rods of
+// length L and mass m joined end to end by revolute joints, from P0 on the
+// ground through P1..P4 back to P5 on the ground; gravity g along -y; released
+// at rest. cstab's coordinates are the rods' ends P1..P4 and their velocities.
+//
+// In Simbody: a tree of five Pin mobilizers, Ground -> rod 1 -> ... -> rod 5,
+// the loop closed at P5 by a Constraint::Ball (rod 5's end on the ground
+// point) plus two Constraint::ConstantAngle rows holding rod 5's joint axis
+// perpendicular to two ground directions that are perpendicular to the ground
+// joint's axis (what a revolute adds to a ball). Five mobilities, five closure
+// rows: Grubler's count is 0, the mechanism moves with 1, so one closure row
+// is redundant and Simbody's projection and multipliers have to cope with a
+// rank-4 constraint Jacobian. `--closure independent` leaves the second
+// ConstantAngle out: four rows, of rank 4 along the motion (the redundancy
+// removed by hand; docs/peers-simbody.md shows what it changes).
+//
+// Every pose is written in the starting configuration: each joint's frame has
+// its z axis on the joint axis (the axis at Pj is d_j x d_{j+1}, d_k = Pk -
+// P(k-1), the ground closing the loop with d_0 = d_6 = P0 - P5), each rod's
+// body frame has its origin at the rod's start and its x axis along the rod,
+// and every Pin's two frames coincide there, so every q = 0 at t = 0.
+//
+// Rods are slender: centre of mass at (L/2, 0, 0), inertia m L^2/12 about the
+// two axes perpendicular to the rod through its centre and 0 about the rod's
+// own axis, i.e. (0, m L^2/3, m L^2/3) about the rod's start (the body
+// origin). Simbody accepts that singular inertia: it satisfies the triangle
+// inequality (0 + I >= I) its Inertia checks, and the tree's mass matrix stays
+// positive definite because each Pin's axis is fixed in, and perpendicular
+// to, its own rod, so every mobility moves mass (a rod's spin about its own
+// axis, carried in from the rods before it, has no inertia and does no work).
+// Gravity's potential is zero at y = 0, as cstab's m g (y1 + y2 + y3 + y4).
+struct BricardModel : Model {
+  double m = 1.0, L = 1.0, g = 9.81;  // as BricardParameters
+  MobilizedBody::Pin rods[5];
+
+  BricardModel(const std::map<std::string, std::string>& params, bool redundant) {
+    if (!params.empty()) bad("--problem-param: bricard has no parameters ('" + params.begin()->first + "')");
+    Force::UniformGravity(forces, matter, Vec3(0, -g, 0));
+    // The joints P0..P5 and the rods' directions d[1..5]; d[0] = d[6] is the
+    // ground's side of the loop, P0 - P5.
+    const Vec3 P[6] = {Vec3(0, 0, 0), Vec3(L, 0, 0), Vec3(L, -L, 0), Vec3(L, -L, L), Vec3(0, -L, L), Vec3(0, 0, L)};
+    Vec3 d[7];
+    for (int k = 1; k <= 5; ++k) d[k] = P[k] - P[k - 1];
+    d[0] = d[6] = P[0] - P[5];
+    // X_GJ[j]: joint j at Pj, z along its axis d_j x d_{j+1}.
+    Transform X_GJ[6];
+    for (int j = 0; j <= 5; ++j) X_GJ[j] = Transform(Rotation(UnitVec3(d[j] % d[j + 1]), ZAxis), P[j]);
+    // X_GB[k]: rod k's body frame, origin P(k-1), x along the rod, y along
+    // the axis of its inboard joint (perpendicular to the rod).
+    Transform X_GB[6];  // X_GB[0]: Ground
+    for (int k = 1; k <= 5; ++k) X_GB[k] = Transform(Rotation(UnitVec3(d[k]), XAxis, X_GJ[k - 1].z(), YAxis), P[k - 1]);
+    const Body::Rigid rod(MassProperties(m, Vec3(L / 2, 0, 0), Inertia(0, m * L * L / 3, m * L * L / 3)));
+    MobilizedBody parent = matter.Ground();
+    for (int k = 1; k <= 5; ++k) {
+      // Joint k-1 joins the parent (Ground or rod k-1) and rod k.
+      rods[k - 1] = MobilizedBody::Pin(parent, ~X_GB[k - 1] * X_GJ[k - 1], rod, ~X_GB[k] * X_GJ[k - 1]);
+      parent = rods[k - 1];
+    }
+    // The closure at P5: rod 5's end on the ground point, and rod 5's axis of
+    // joint 5 (fixed in rod 5) kept perpendicular to the ground joint frame's
+    // x and y, i.e. along its z: 3 + 2 rows (3 + 1 if not redundant).
+    MobilizedBody::Pin& rod5 = rods[4];
+    Constraint::Ball(matter.Ground(), P[5], rod5, Vec3(L, 0, 0));
+    const UnitVec3 axis5_in_rod5(~X_GB[5].R() * X_GJ[5].z());
+    Constraint::ConstantAngle(matter.Ground(), UnitVec3(X_GJ[5].x()), rod5, axis5_in_rod5, Pi / 2);
+    if (redundant) Constraint::ConstantAngle(matter.Ground(), UnitVec3(X_GJ[5].y()), rod5, axis5_in_rod5, Pi / 2);
+  }
+  std::vector<std::string> columns() const override {
+    std::vector<std::string> c;
+    for (const char* suffix : {"", "dot"})
+      for (int k = 1; k <= 4; ++k)
+        for (const char* axis : {"x", "y", "z"}) c.push_back(axis + std::to_string(k) + suffix);
+    return c;
+  }
+  void initial_state(State& s) const override {
+    // The benchmark's start is the configuration the frames were laid out in.
+    for (const auto& r : rods) {
+      r.setOneQ(s, 0, 0);
+      r.setOneU(s, 0, 0);
+    }
+  }
+  void canonical(const State& s, double* c) const override {
+    system.realize(s, Stage::Velocity);
+    for (int k = 0; k < 4; ++k) {
+      // Pk+1 is rod k+1's far end.
+      const Vec3 p = rods[k].findStationLocationInGround(s, Vec3(L, 0, 0));
+      const Vec3 v = rods[k].findStationVelocityInGround(s, Vec3(L, 0, 0));
+      for (int i = 0; i < 3; ++i) c[3 * k + i] = p[i], c[12 + 3 * k + i] = v[i];
+    }
+  }
+};
+
+// cstab's `andrews` (Andrews' squeezing mechanism as the IVP Test Set
+// defines it, problems/andrews/andrews.hpp; Hairer & Wanner II, VII.7):
+// seven bodies in the plane, no gravity, a constant torque mom on the crank
+// and a spring c0 (free length l0) from the ground point C to the point D of
+// body 3. The Test Set's coordinates are the angles
+// (beta, Theta, gamma, Phi, delta, Omega, epsilon): beta, gamma, delta and
+// epsilon absolute, Theta, Phi and Omega relative to the body carrying the
+// joint. In Simbody each is one Pin's q, every rotation about z:
+//   Ground -O- body 1 (beta) -[rr, 0]- body 2 (Theta)
+//   Ground -B- body 3 (gamma)
+//   Ground -A- body 5 (delta) -[zt, 0]- body 4 (Phi)
+//   Ground -A- body 7 (epsilon) -[0, -u]- body 6 (Omega)
+// and the loop closes where all three chains meet the point F: F on body 2
+// at (-d, 0), on body 3 at (0, -ss), on body 4 at (0, -e), on body 6 at
+// (zf, 0) in their frames (read off the Test Set's g1..g6). Three
+// Constraint::PointOnLine, each holding body 2's F on the z line through
+// another body's F, give the six rows of g (planar coincidences, as for the
+// slider crank); 7 mobilities, 6 independent rows, 1 degree of freedom.
+//
+// Masses and inertias: each body's central inertia i_k about z (the only
+// axis that turns; (i/2, i/2, i) makes a valid 3-D inertia) at its centre of
+// mass, which sits where the Test Set's mass matrix puts it: body 2 at
+// (-da, 0), body 4 at (0, -(e - ea)), body 6 at (zf - fa, 0) (the joint
+// terms of M(q)), and bodies 1, 3, 5, 7, which turn about a ground point, at
+// (ra, 0), (sa, sb), (ta, tb), (ua, ub) (only the distance enters M).
+struct AndrewsModel : Model {
+  // As AndrewsParameters (the Test Set's values).
+  double m1 = .04325, m2 = .00365, m3 = .02373, m4 = .00706, m5 = .07050, m6 = .00706, m7 = .05498;
+  double xa = -.06934, ya = -.00227, xb = -.03635, yb = .03273, xc = .014, yc = .072;
+  double c0 = 4530;
+  double i1 = 2.194e-6, i2 = 4.410e-7, i3 = 5.255e-6, i4 = 5.667e-7, i5 = 1.169e-5, i6 = 5.667e-7, i7 = 1.912e-5;
+  double d = 28e-3, da = 115e-4, e = 2e-2, ea = 1421e-5, rr = 7e-3, ra = 92e-5, l0 = 7785e-5;
+  double ss = 35e-3, sa = 1874e-5, sb = 1043e-5, sc = 18e-3, sd = 2e-2;
+  double ta = 2308e-5, tb = 916e-5, u = 4e-2, ua = 1228e-5, ub = 449e-5;
+  double zf = 2e-2, zt = 4e-2, fa = 1421e-5, mom = 33e-3;
+  // In the Test Set's order beta, Theta, gamma, Phi, delta, Omega, epsilon.
+  MobilizedBody::Pin joints[7];
+
+  static Body::Rigid body(double m, const Vec3& com, double i) {
+    return Body::Rigid(MassProperties(m, com, Inertia(i / 2, i / 2, i).shiftFromMassCenter(com, m)));
+  }
+
+  explicit AndrewsModel(const std::map<std::string, std::string>& params) {
+    if (!params.empty()) bad("--problem-param: andrews has no parameters ('" + params.begin()->first + "')");
+    auto& G = matter.Ground();
+    auto at = [](double x, double y) { return Transform(Vec3(x, y, 0)); };
+    MobilizedBody::Pin b1(G, Transform(), body(m1, Vec3(ra, 0, 0), i1), Transform());
+    MobilizedBody::Pin b2(b1, at(rr, 0), body(m2, Vec3(-da, 0, 0), i2), Transform());
+    MobilizedBody::Pin b3(G, at(xb, yb), body(m3, Vec3(sa, sb, 0), i3), Transform());
+    MobilizedBody::Pin b5(G, at(xa, ya), body(m5, Vec3(ta, tb, 0), i5), Transform());
+    MobilizedBody::Pin b4(b5, at(zt, 0), body(m4, Vec3(0, -(e - ea), 0), i4), Transform());
+    MobilizedBody::Pin b7(G, at(xa, ya), body(m7, Vec3(ua, ub, 0), i7), Transform());
+    MobilizedBody::Pin b6(b7, at(0, -u), body(m6, Vec3(zf - fa, 0, 0), i6), Transform());
+    joints[0] = b1, joints[1] = b2, joints[2] = b3, joints[3] = b4, joints[4] = b5, joints[5] = b6, joints[6] = b7;
+    const Vec3 f2(-d, 0, 0);
+    Constraint::PointOnLine(b3, UnitVec3(ZAxis), Vec3(0, -ss, 0), b2, f2);
+    Constraint::PointOnLine(b4, UnitVec3(ZAxis), Vec3(0, -e, 0), b2, f2);
+    Constraint::PointOnLine(b6, UnitVec3(ZAxis), Vec3(zf, 0, 0), b2, f2);
+    Force::MobilityConstantForce(forces, b1, 0, mom);
+    Force::TwoPointLinearSpring(forces, G, Vec3(xc, yc, 0), b3, Vec3(sd, -sc, 0), c0, l0);
+  }
+  std::vector<std::string> columns() const override {
+    std::vector<std::string> c;
+    for (const char* suffix : {"", "dot"})
+      for (const char* name : {"beta", "Theta", "gamma", "Phi", "delta", "Omega", "epsilon"})
+        c.push_back(name + std::string(suffix));
+    return c;
+  }
+  void initial_state(State& s) const override {
+    // The Test Set's consistent initial values (its y1..y7), at rest.
+    const double q0[7] = {-0.0617138900142764496358948458001, 0.0,
+                          0.455279819163070380255912382449,   0.222668390165885884674473185609,
+                          0.487364979543842550225598953530,   -0.222668390165885884674473185609,
+                          1.23054744454982119249735015568};
+    for (int k = 0; k < 7; ++k) {
+      joints[k].setOneQ(s, 0, q0[k]);
+      joints[k].setOneU(s, 0, 0);
+    }
+  }
+  void canonical(const State& s, double* c) const override {
+    for (int k = 0; k < 7; ++k) c[k] = joints[k].getOneQ(s, 0), c[7 + k] = joints[k].getOneU(s, 0);
+  }
+};
+
 std::unique_ptr<Integrator> make_integrator(const std::string& name, const System& system) {
   if (name == "rk3") return std::make_unique<RungeKutta3Integrator>(system);
   if (name == "rkmerson") return std::make_unique<RungeKuttaMersonIntegrator>(system);
@@ -271,8 +457,12 @@ int main(int argc, char** argv) {
     o = parse(argc, argv);
     if (o.problem == "pendulum")
       model = std::make_unique<PendulumModel>(o.params);
-    else
+    else if (o.problem == "slider-crank")
       model = std::make_unique<SliderCrankModel>(o.params);
+    else if (o.problem == "bricard")
+      model = std::make_unique<BricardModel>(o.params, o.closure == "redundant");
+    else
+      model = std::make_unique<AndrewsModel>(o.params);
     out.open(o.out);
     if (!out) bad("--out: cannot write '" + o.out + "'");
   } catch (const BadInput& e) {
@@ -361,6 +551,7 @@ int main(int argc, char** argv) {
   };
   out << "# wall_seconds = " << g17(wall) << "\n";
   out << "# simbody_problem = " << o.problem << "\n";
+  if (!o.closure.empty()) out << "# simbody_closure = " << o.closure << "\n";
   out << "# simbody_integrator = " << o.integrator << " (" << (integ ? integ->getMethodName() : "?") << ")\n";
   out << "# simbody_accuracy = " << g17(accuracy_in_use) << "\n";
   out << "# simbody_constraint_tolerance = " << g17(tolerance_in_use) << "\n";
