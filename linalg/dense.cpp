@@ -119,9 +119,7 @@ void Cod::solve(const double* r, double* x) const {
 int Cod::rank() const { return int(impl_->cod.rank()); }
 
 // Unblocked, column by column: a Newton matrix has a few to a few dozen
-// rows, too few for blocking to pay. On car-axis' 6 x 6 hht steps it takes
-// fewer instructions than Eigen's fixed-size PartialPivLU did (callgrind:
-// 68e6 against 87e6 in 30000 steps, docs/build.md).
+// rows, too few for blocking to pay (docs/build.md).
 struct Lu::Impl {
   explicit Impl(int n) : n(n), lu(std::size_t(n) * std::size_t(n)), pivot(std::size_t(n)) {}
   int n;
@@ -136,17 +134,21 @@ Lu& Lu::operator=(Lu&&) noexcept = default;
 
 int Lu::size() const { return impl_->n; }
 
-void Lu::compute(const double* a) {
-  const int n = impl_->n;
-  double* m = impl_->lu.data();
-  std::copy(a, a + std::size_t(n) * std::size_t(n), m);
+namespace {
+
+// The factorization and the solve for n rows; N > 0 fixes n at compile time
+// (N = n), so that the loops of the small sizes unroll, N = 0 leaves it
+// dynamic. Both are compiled here only, for N = 0 .. kLuFixedMax.
+template <int N>
+void lu_factor(int n_dynamic, double* m, int* pivot) {
+  const int n = N > 0 ? N : n_dynamic;
   for (int k = 0; k < n; ++k) {
     double* ck = m + std::size_t(k) * n;
     int p = k;
     double best = std::abs(ck[k]);
     for (int i = k + 1; i < n; ++i)
       if (std::abs(ck[i]) > best) best = std::abs(ck[i]), p = i;
-    impl_->pivot[k] = p;
+    pivot[k] = p;
     if (p != k)
       for (int j = 0; j < n; ++j) std::swap(m[std::size_t(j) * n + k], m[std::size_t(j) * n + p]);
     // A zero pivot leaves infinities and NaNs in the factors, as Eigen's
@@ -156,22 +158,19 @@ void Lu::compute(const double* a) {
     for (int j = k + 1; j < n; ++j) {
       double* cj = m + std::size_t(j) * n;
       const double akj = cj[k];
-      if (akj == 0.0) continue;
       for (int i = k + 1; i < n; ++i) cj[i] -= ck[i] * akj;
     }
   }
 }
 
-void Lu::solve(const double* b, double* x) const {
-  const int n = impl_->n;
-  const double* m = impl_->lu.data();
-  if (x != b) std::copy(b, b + n, x);
-  for (int k = 0; k < n; ++k) std::swap(x[k], x[impl_->pivot[k]]);
+template <int N>
+void lu_solve_factored(int n_dynamic, const double* m, const int* pivot, double* x) {
+  const int n = N > 0 ? N : n_dynamic;
+  for (int k = 0; k < n; ++k) std::swap(x[k], x[pivot[k]]);
   for (int k = 0; k < n; ++k) {  // L y = P b, column-oriented
     const double* ck = m + std::size_t(k) * n;
     const double xk = x[k];
-    if (xk != 0.0)
-      for (int i = k + 1; i < n; ++i) x[i] -= ck[i] * xk;
+    for (int i = k + 1; i < n; ++i) x[i] -= ck[i] * xk;
   }
   for (int k = n - 1; k >= 0; --k) {  // U x = y
     const double* ck = m + std::size_t(k) * n;
@@ -179,6 +178,43 @@ void Lu::solve(const double* b, double* x) const {
     const double xk = x[k];
     for (int i = 0; i < k; ++i) x[i] -= ck[i] * xk;
   }
+}
+
+constexpr int kLuFixedMax = 8;
+
+template <class Call, int... Ns>
+void lu_dispatch(int n, Call&& call, std::integer_sequence<int, Ns...>) {
+  // The unrolled kernel of n's size where there is one, the dynamic one
+  // otherwise.
+  const bool fixed = ((n == Ns + 1 ? (call(std::integral_constant<int, Ns + 1>{}), true) : false) || ...);
+  if (!fixed) call(std::integral_constant<int, 0>{});
+}
+
+}  // namespace
+
+void Lu::compute(const double* a) {
+  const int n = impl_->n;
+  double* m = impl_->lu.data();
+  int* pivot = impl_->pivot.data();
+  std::copy(a, a + std::size_t(n) * std::size_t(n), m);
+  lu_dispatch(
+      n, [&](auto size) { lu_factor<decltype(size)::value>(n, m, pivot); },
+      std::make_integer_sequence<int, kLuFixedMax>{});
+}
+
+void Lu::solve(const double* b, double* x) const {
+  const int n = impl_->n;
+  if (x != b) std::copy(b, b + n, x);
+  const double* m = impl_->lu.data();
+  const int* pivot = impl_->pivot.data();
+  lu_dispatch(
+      n, [&](auto size) { lu_solve_factored<decltype(size)::value>(n, m, pivot, x); },
+      std::make_integer_sequence<int, kLuFixedMax>{});
+}
+
+void Lu::solve_columns(const double* b, double* x, int columns) const {
+  const std::size_t n = std::size_t(impl_->n);
+  for (int j = 0; j < columns; ++j) solve(b + j * n, x + j * n);
 }
 
 }  // namespace cstab::linalg

@@ -67,9 +67,9 @@ class Cod {
 // Partial-pivoting LU of an n x n matrix, for the Newton iterations of the
 // implicit schemes (generalized-alpha and its kin, ali3p): compiled once for
 // every size, where Eigen's fixed-size PartialPivLU is compiled again for
-// each size in every method's pair unit. Storage is allocated at
-// construction; compute() and solve() do not allocate. A singular matrix
-// gives a non-finite solution.
+// each size in every method's pair unit; unrolled kernels for n <= 8.
+// Storage is allocated at construction; compute() and solve() do not
+// allocate. A singular matrix gives a non-finite solution.
 class Lu {
  public:
   explicit Lu(int n);
@@ -81,6 +81,7 @@ class Lu {
 
   void compute(const double* a);                 // column-major n x n
   void solve(const double* b, double* x) const;  // x = A^-1 b; x may alias b
+  void solve_columns(const double* b, double* x, int columns) const;  // column-major n x columns; may alias
   int size() const;
 
  private:

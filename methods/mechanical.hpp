@@ -140,6 +140,9 @@ struct MechanicalTerms : MechanicalSizes<Model> {
   void evaluate_velocity(const Model& model, double t, const VecQ& q, const VecQ& v);
   // Everything: M, Q, the constraint rows, gamma; the energy terms if asked.
   void evaluate(const Model& model, double t, const VecQ& q, const VecQ& v, bool with_energy);
+  // dQ/dv at (t, q, v) by forward AD, in the duals every model's forces
+  // compile with (contracts' MechanicalDual), into dQdv.
+  static void force_velocity_jacobian(const Model& model, double t, const VecQ& q, const VecQ& v, MatQ& dQdv);
 
  private:
   // (t, q, v) as duals with nq + 1 directions: the nq velocities, then the
@@ -163,6 +166,19 @@ struct MechanicalTerms : MechanicalSizes<Model> {
   void holonomic_terms_ad(const Model& model, double t, const VecQ& q, const VecQ& v);
   void nonholonomic_terms(const Model& model, double t, const VecQ& q, const VecQ& v);
 };
+
+template <class Model>
+void MechanicalTerms<Model>::force_velocity_jacobian(const Model& model, double t, const VecQ& q, const VecQ& v,
+                                                     MatQ& dQdv) {
+  using D = ad::Dual<nq + 1>;
+  Vec<D, nq> qd, vd, Qd;
+  for (int i = 0; i < nq; ++i) {
+    qd(i) = D(q(i));
+    vd(i) = D(v(i), nq + 1, i);
+  }
+  model.forces(D(t), qd, vd, Qd);
+  for (int i = 0; i < nq; ++i) dQdv.row(i) = Qd(i).derivatives().template head<nq>().transpose();
+}
 
 template <class Model>
 void MechanicalTerms<Model>::evaluate_position(const Model& model, double t, const VecQ& q) {

@@ -136,8 +136,10 @@ class RattleFormulation final : public SelfSteppingFormulation<Model> {
         }
         if (iterations == settings_.max_iterations) break;
         ++iterations;
-        newton_lu_.compute(MatH((h * hh) * (terms_.A * MinvGt)));
-        const VecH dl = newton_lu_.solve(VecH(-terms_.phi));
+        S_ = (h * hh) * (terms_.A * MinvGt);
+        newton_lu_.compute(S_.data());
+        VecH dl = -terms_.phi;
+        newton_lu_.solve(dl.data(), dl.data());
         if (!dl.allFinite()) break;
         lambda += dl;
       }
@@ -151,7 +153,8 @@ class RattleFormulation final : public SelfSteppingFormulation<Model> {
       v_half = vt + hh * (MinvGt * lambda);
       // G(q1), Phi_t(t1, q1): the last evaluation. The velocity solve's matrix.
       MinvG1t_ = llt_.solve(MatQH(terms_.A.transpose()));
-      velocity_lu_.compute(MatH(terms_.A * MinvG1t_));
+      S_ = terms_.A * MinvG1t_;
+      velocity_lu_.compute(S_.data());
     } else {
       count_step(0, true);
     }
@@ -170,14 +173,18 @@ class RattleFormulation final : public SelfSteppingFormulation<Model> {
       this->model_.forces(t1, q1, v1, Q_);
       ++evaluations_;
       VecQ dv = v_half + hh * llt_.solve(Q_);
-      if constexpr (nh > 0) dv += MinvG1t_ * velocity_lu_.solve(VecH(-(terms_.A * dv + terms_.phi_t)));
+      if constexpr (nh > 0) {
+        VecH r = -(terms_.A * dv + terms_.phi_t);
+        velocity_lu_.solve(r.data(), r.data());
+        dv += MinvG1t_ * r;
+      }
       dv -= v1;
       const double scale = 1 + v1.template lpNorm<Eigen::Infinity>();
       if (pass == 1 && !(dv.template lpNorm<Eigen::Infinity>() <= settings_.tol * scale)) {
         kick_newton_matrix(t1, q1, v1, hh);
         newton = true;
       }
-      if (newton) dv = kick_lu_.solve(dv);
+      if (newton) kick_lu_.solve(dv.data(), dv.data());
       v1 += dv;
       change = dv.template lpNorm<Eigen::Infinity>() / (1 + v1.template lpNorm<Eigen::Infinity>());
       if (pass > 0 && change <= settings_.tol) {
@@ -202,21 +209,19 @@ class RattleFormulation final : public SelfSteppingFormulation<Model> {
 
  private:
   // I - P (h/2) M^-1 dQ/dv at (t1, q1, v1) into kick_lu_, P = I - M^-1 G^T
-  // (G M^-1 G^T)^-1 G at q1 (the last position evaluation); dQ/dv by AD in the
-  // scalar every model's forces compile with (the contract's MechanicalDual).
+  // (G M^-1 G^T)^-1 G at q1 (the last position evaluation); dQ/dv by AD,
+  // compiled once per model (MechanicalTerms).
   void kick_newton_matrix(double t1, const VecQ& q1, const VecQ& v1, double hh) {
-    using D = contracts::detail::MechanicalDual<Model>;
-    Vec<D, nq> qd, vd, Qd;
-    for (int i = 0; i < nq; ++i) {
-      qd(i) = D(q1(i));
-      vd(i) = D(v1(i), nq + 1, i);
-    }
-    this->model_.forces(D(t1), qd, vd, Qd);
+    MechanicalTerms<Model>::force_velocity_jacobian(this->model_, t1, q1, v1, Qv_);
     ++evaluations_;
-    for (int i = 0; i < nq; ++i) Qv_.row(i) = Qd(i).derivatives().template head<nq>().transpose();
     MatQ F = hh * llt_.solve(Qv_);
-    if constexpr (nh > 0) F -= MinvG1t_ * velocity_lu_.solve(MatHQ(terms_.A * F));
-    kick_lu_.compute(MatQ(MatQ::Identity() - F));
+    if constexpr (nh > 0) {
+      hq_ = terms_.A * F;
+      velocity_lu_.solve_columns(hq_.data(), hq_.data(), nq);
+      F -= MinvG1t_ * hq_;
+    }
+    F = MatQ::Identity() - F;
+    kick_lu_.compute(F.data());
   }
 
   RattleSettings settings_;
@@ -225,9 +230,12 @@ class RattleFormulation final : public SelfSteppingFormulation<Model> {
   MechanicalTerms<Model> terms_;
   VecQ Q_;
   MatQH MinvG1t_;
-  Eigen::PartialPivLU<MatH> newton_lu_, velocity_lu_;
+  MatH S_;  // the position and velocity solves' matrices
+  // Dynamic-size LUs, compiled once (linalg/dense.cpp).
+  linalg::Lu newton_lu_{nh}, velocity_lu_{nh};
   MatQ Qv_;
-  Eigen::PartialPivLU<MatQ> kick_lu_;
+  MatHQ hq_;
+  linalg::Lu kick_lu_{nq};
   long newton_kicks_ = 0;  // steps whose half-kick needed Newton
   bool have_last_ = false;
   double last_t_ = 0;

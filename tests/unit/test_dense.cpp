@@ -133,5 +133,22 @@ TEST(Lu, RefactorsAndSolvesInPlaceAtKktSizes) {
   }
 }
 
+TEST(Lu, SolvesSeveralColumnsAsEachAlone) {
+  std::srand(13);
+  const int n = 7, columns = 4;
+  const Eigen::MatrixXd a = Eigen::MatrixXd::Random(n, n) + 4 * Eigen::MatrixXd::Identity(n, n);
+  const Eigen::MatrixXd b = Eigen::MatrixXd::Random(n, columns);
+  linalg::Lu lu(n);
+  lu.compute(a.data());
+  Eigen::MatrixXd x = b;
+  lu.solve_columns(x.data(), x.data(), columns);
+  EXPECT_LT((a * x - b).norm(), 1e-13 * b.norm());
+  for (int j = 0; j < columns; ++j) {
+    Eigen::VectorXd alone(n);
+    lu.solve(b.col(j).data(), alone.data());
+    EXPECT_EQ((x.col(j) - alone).norm(), 0.0) << j;
+  }
+}
+
 }  // namespace
 }  // namespace cstab
