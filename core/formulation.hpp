@@ -20,6 +20,13 @@ class OdeSystem {
   // reaction matrix, non-finite input); failure_reason() then says why.
   virtual bool rhs(double t, const double* y, double* dydt) = 0;
   virtual const std::string& failure_reason() const { return no_failure_; }
+  // df/dy at (t, y), dense and column-major (J[i + j n] = df_i/dy_j), for
+  // the implicit integrators. A system that gives one says so with
+  // has_jacobian(); jacobian() may still return false at a point where it
+  // has none (e.g. redundant constraint rows), and the integrator then
+  // takes difference quotients there. Must not allocate.
+  virtual bool has_jacobian() const { return false; }
+  virtual bool jacobian(double /*t*/, const double* /*y*/, double* /*J*/) { return false; }
 
  private:
   std::string no_failure_;

@@ -102,6 +102,8 @@ StepAllocations count_step_allocations(Formulation& form, const std::string& int
     out.library_allocations = w.library_count();
   }
   if (jac_before >= 0) out.jacobian_evaluations = jacobian_evaluations() - jac_before;
+  for (const auto& [name, value] : integ->statistics())
+    if (name == "jacobian") out.system_jacobian = value == "system";
   if (out.taken < steps) out.failure = integ->failure_reason();
   return out;
 }

@@ -36,6 +36,7 @@ struct StepAllocations {
   long allocations = 0;          // heap allocations in them (AllocationWindow::count)
   long library_allocations = 0;  // and GSL's or SUNDIALS' own (library_count)
   long jacobian_evaluations = -1;  // the integrator's, in the window (-1: it reports none)
+  bool system_jacobian = false;    // the integrator used the system's Jacobian ("jacobian" = "system")
   std::string failure;   // why a step failed (warm-up or window)
   bool warmup_failed = false;
 };

@@ -4,7 +4,9 @@
 //                      Butcher table (erk_tables() below);
 //   ark-dirk-<table> : ARKStep with the whole right-hand side implicit
 //                      (a DIRK table), Newton iteration with a dense direct
-//                      linear solver and ARKODE's difference-quotient Jacobian.
+//                      linear solver and the system's Jacobian where it has
+//                      one (AD for the index-1 methods), otherwise ARKODE's
+//                      difference-quotient Jacobian.
 // The table is part of the integrator's name, so it is one value wherever an
 // integrator is named (--integrator, matrix files, summary columns); an
 // unknown table is a UsageError naming the valid ones (find_integrator).
@@ -78,6 +80,7 @@ class ArkodeIntegrator final : public SundialsIntegrator {
     std::vector<std::pair<std::string, std::string>> out;
     counts_.append(out, raw(), implicit_ ? kCounters : kExplicitCounters);
     out.emplace_back("ark_restarts", std::to_string(counts_.restarts()));
+    if (implicit_) append_jacobian_statistics(out);
     out.emplace_back("ark_last_step", format_exact(last_step()));
     return out;
   }
@@ -160,6 +163,9 @@ class ArkodeIntegrator final : public SundialsIntegrator {
       if (flag == ARK_SUCCESS) {
         if (!make_dense_linear_solver()) return setup_failed("out of memory");
         flag = ARKStepSetLinearSolver(mem_, linear_solver_, matrix_);
+        system_jacobian_ = use_system_jacobian();
+        if (flag == ARK_SUCCESS && system_jacobian_)
+          flag = ARKStepSetJacFn(mem_, &SundialsIntegrator::jacobian_callback);
       }
     } else {
       mem_ = ERKStepCreate(&SundialsIntegrator::rhs_callback, t0, yy_, ctx_);
@@ -189,8 +195,10 @@ void add_arkode_integrators(std::vector<IntegratorInfo>& list) {
                     t.order});
   for (const auto& t : ark_dirk_tables())
     list.push_back({std::string("ark-dirk-") + t.suffix,
-                    std::string("SUNDIALS ARKODE ARKStep, implicit adaptive DIRK (Newton, dense difference-quotient "
-                                "Jacobian): ") + t.description, false, t.order});
+                    std::string("SUNDIALS ARKODE ARKStep, implicit adaptive DIRK (Newton, dense Jacobian: the "
+                                "method's own by AD where it has one, else difference quotients): ") +
+                        t.description,
+                    false, t.order});
 }
 
 std::string arkode_unknown_table(const std::string& name) {

@@ -3,8 +3,10 @@
 // with CVodeSetStopTime(t_limit)) so the harness observes, projects and
 // detects divergence between steps, like the "ida" wrapper.
 //   cvode-bdf   : variable-order BDF (orders 1-5), Newton iteration with a
-//                 dense direct linear solver and CVODE's difference-quotient
-//                 dense Jacobian (n extra right-hand sides per Jacobian).
+//                 dense direct linear solver and the system's Jacobian where
+//                 it has one (OdeSystem::jacobian: AD for the index-1
+//                 methods), otherwise CVODE's difference-quotient dense
+//                 Jacobian (n extra right-hand sides per Jacobian).
 //   cvode-adams : variable-order Adams-Moulton (orders 1-12), fixed-point
 //                 (functional) iteration: no Jacobian, no linear solver, the
 //                 usual choice for non-stiff problems.
@@ -90,6 +92,7 @@ class CvodeIntegrator final : public SundialsIntegrator {
     std::vector<std::pair<std::string, std::string>> out;
     counts_.append(out, raw());
     out.emplace_back("cvode_restarts", std::to_string(counts_.restarts()));
+    if (bdf_) append_jacobian_statistics(out);
     if (projected_form_) {
       long proj_fails = 0;
       if (mem_) CVodeGetNumProjFails(mem_, &proj_fails);
@@ -155,6 +158,8 @@ class CvodeIntegrator final : public SundialsIntegrator {
     if (bdf_) {
       if (!make_dense_linear_solver()) return setup_failed("out of memory");
       flag = CVodeSetLinearSolver(mem_, linear_solver_, matrix_);
+      system_jacobian_ = use_system_jacobian();
+      if (flag == CV_SUCCESS && system_jacobian_) flag = CVodeSetJacFn(mem_, &SundialsIntegrator::jacobian_callback);
     } else {
       nonlinear_solver_ = SUNNonlinSol_FixedPoint(yy_, 0, ctx_);
       if (!nonlinear_solver_) return setup_failed("out of memory");

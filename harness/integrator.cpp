@@ -20,26 +20,37 @@ std::string arkode_unknown_table(const std::string& name);              // arkod
 const std::vector<IntegratorInfo>& all_integrators() {
   static const std::vector<IntegratorInfo> list = [] {
     std::vector<IntegratorInfo> l = {
-      {"euler", "explicit (forward) Euler, fixed step", true, 1},
-      {"rk4", "classical 4th-order Runge-Kutta, fixed step", true, 4},
-      {"adams", "Adams-Bashforth-Moulton PECE, 4th order, fixed step (RK4 start-up)", true, 4},
-      {"rk8pd", "GSL Prince-Dormand 8(9), adaptive", false, 8},
-      {"rkf45", "GSL Runge-Kutta-Fehlberg 4(5), adaptive", false, 5},
-      {"msadams", "GSL variable-order Adams (orders 1-12), adaptive", false, 12},
-      {"msbdf", "GSL variable-order BDF (orders 1-5), adaptive, implicit", false, 5},
-      {"ida", "SUNDIALS IDA variable-order BDF (orders 1-5) for DAEs F(t, y, y') = 0, adaptive; "
-              "needs a DAE method (ida-index1, ida-ggl)", false, 5, MethodKind::kDae},
-      {"cvode-bdf", "SUNDIALS CVODE variable-order BDF (orders 1-5), adaptive, implicit: Newton with a dense "
-                    "difference-quotient Jacobian", false, 5},
-      {"cvode-adams", "SUNDIALS CVODE variable-order Adams-Moulton (orders 1-12), adaptive, fixed-point iteration",
-       false, 12},
-      {"cvode-projection", "cvode-bdf with the method's post-step projection inside CVODE (CVodeSetProjFn, "
-                           "projected error estimate): no restart after a projection", false, 5},
-      {"cvode-projection-noerr", "cvode-projection without projecting the error estimate (CVodeSetProjErrEst off)",
-       false, 5},
-      {"own", "the method's own fixed-step scheme, for the methods that step themselves (their description "
-              "says --integrator own); off-grid output by a side step of the scheme",
-       true, 2, MethodKind::kSelfStepping},
+        {"euler", "explicit (forward) Euler, fixed step", true, 1},
+        {"rk4", "classical 4th-order Runge-Kutta, fixed step", true, 4},
+        {"adams", "Adams-Bashforth-Moulton PECE, 4th order, fixed step (RK4 start-up)", true, 4},
+        {"rk8pd", "GSL Prince-Dormand 8(9), adaptive", false, 8},
+        {"rkf45", "GSL Runge-Kutta-Fehlberg 4(5), adaptive", false, 5},
+        {"msadams", "GSL variable-order Adams (orders 1-12), adaptive", false, 12},
+        {"msbdf",
+         "GSL variable-order BDF (orders 1-5), adaptive, implicit; the method's own Jacobian by AD where "
+         "it has one (index-1 methods), else difference quotients",
+         false, 5},
+        {"ida",
+         "SUNDIALS IDA variable-order BDF (orders 1-5) for DAEs F(t, y, y') = 0, adaptive; "
+         "needs a DAE method (ida-index1, ida-ggl)",
+         false, 5, MethodKind::kDae},
+        {"cvode-bdf",
+         "SUNDIALS CVODE variable-order BDF (orders 1-5), adaptive, implicit: Newton with a dense "
+         "Jacobian, the method's own by AD where it has one (index-1 methods), else difference "
+         "quotients",
+         false, 5},
+        {"cvode-adams", "SUNDIALS CVODE variable-order Adams-Moulton (orders 1-12), adaptive, fixed-point iteration",
+         false, 12},
+        {"cvode-projection",
+         "cvode-bdf with the method's post-step projection inside CVODE (CVodeSetProjFn, "
+         "projected error estimate): no restart after a projection",
+         false, 5},
+        {"cvode-projection-noerr", "cvode-projection without projecting the error estimate (CVodeSetProjErrEst off)",
+         false, 5},
+        {"own",
+         "the method's own fixed-step scheme, for the methods that step themselves (their description "
+         "says --integrator own); off-grid output by a side step of the scheme",
+         true, 2, MethodKind::kSelfStepping},
     };
     add_arkode_integrators(l);
     return l;
@@ -300,6 +311,10 @@ class GslAdaptive final : public Integrator {
     steps_ = rejected_ = rhs_evals_ = 0;
     failure_.clear();
     fd_f0_.assign(n_, 0); fd_f1_.assign(n_, 0); fd_y_.assign(n_, 0);
+    jac_.assign(size_t(n_) * n_, 0);
+    system_jacobians_ = 0;
+    const char* mode = std::getenv("CSTAB_JACOBIAN");
+    system_jacobian_ = sys.has_jacobian() && !(mode && std::string(mode) == "dq");
     gsys_ = gsl_odeiv2_system{&GslAdaptive::gsl_rhs, &GslAdaptive::gsl_jac, size_t(n_), this};
     h_ = 1e-6;
     driver_ = gsl_odeiv2_driver_alloc_y_new(&gsys_, type_, h_, settings_.atol, settings_.rtol);
@@ -331,6 +346,14 @@ class GslAdaptive final : public Integrator {
     return true;
   }
 
+  // The implicit scheme's Jacobian: the system's (dfdt by a forward
+  // difference) or difference quotients; system_jacobians counts the first.
+  std::vector<std::pair<std::string, std::string>> statistics() const override {
+    if (type_ != gsl_odeiv2_step_msbdf) return {};
+    return {{"jacobian", system_jacobian_ ? "system" : "dq"},
+            {"msbdf_system_jacobians", std::to_string(system_jacobians_)}};
+  }
+
   bool notify_modified() override {
     // Multistep history is invalid after y changed.
     gsl_odeiv2_evolve_reset(driver_->e);
@@ -355,7 +378,17 @@ class GslAdaptive final : public Integrator {
     if (!self->eval(t, y, self->fd_f0_.data())) return GSL_EBADFUNC;
     std::copy(y, y + n, self->fd_y_.begin());
     static const bool central = std::getenv("CSTAB_MSBDF_CENTRAL_JACOBIAN") != nullptr;
-    for (int j = 0; j < n; ++j) {
+    // The system's own (column-major; GSL's is row-major), where it has one.
+    bool have = false;
+    if (self->system_jacobian_ && !central) {
+      have = self->sys_->jacobian(t, y, self->jac_.data());
+      if (have) {
+        ++self->system_jacobians_;
+        for (int j = 0; j < n; ++j)
+          for (int i = 0; i < n; ++i) dfdy[i * n + j] = self->jac_[i + j * n];
+      }
+    }
+    for (int j = 0; j < n && !have; ++j) {
       if (central) {
         const double dy = std::cbrt(2.2e-16) * std::max(1.0, std::abs(y[j]));
         self->fd_y_[j] = y[j] + dy;
@@ -389,7 +422,9 @@ class GslAdaptive final : public Integrator {
   gsl_odeiv2_system gsys_{};
   gsl_odeiv2_driver* driver_ = nullptr;
   double h_ = 0;
-  std::vector<double> fd_f0_, fd_f1_, fd_y_;
+  std::vector<double> fd_f0_, fd_f1_, fd_y_, jac_;
+  bool system_jacobian_ = false;  // the system's own Jacobian (CSTAB_JACOBIAN=dq: difference quotients)
+  long system_jacobians_ = 0;
 };
 
 }  // namespace

@@ -184,6 +184,18 @@ class SundialsIntegrator : public Integrator {
   int callback_failed(double t);
   // y' = f(t, y) by the system, for CVODE and ARKODE.
   static int rhs_callback(realtype t, N_Vector y, N_Vector ydot, void* user_data);
+  // The system's own Jacobian (OdeSystem::jacobian: AD for the index-1
+  // methods), for CVODE's and ARKODE's dense linear solver; at a point
+  // where it has none, forward difference quotients (jac_dq_points_).
+  static int jacobian_callback(realtype t, N_Vector y, N_Vector fy, SUNMatrix J, void* user_data, N_Vector tmp1,
+                               N_Vector tmp2, N_Vector tmp3);
+  // Whether to pass jacobian_callback to the package: the system has a
+  // Jacobian, and CSTAB_JACOBIAN=dq (a diagnostic: the packages' own
+  // difference quotients, for comparison) is not set.
+  bool use_system_jacobian() const;
+  // "jacobian" (system or dq) and, with the system's, "jac_dq_points" as
+  // summary columns.
+  void append_jacobian_statistics(std::vector<std::pair<std::string, std::string>>& out) const;
   // The package's own message for the last error, kept for
   // failure_reason() instead of being printed to stderr.
   static void error_handler(int, const char*, const char* function, char* msg, void* user_data);
@@ -196,6 +208,8 @@ class SundialsIntegrator : public Integrator {
   SUNLinearSolver linear_solver_ = nullptr;
   SUNNonlinearSolver nonlinear_solver_ = nullptr;
   bool ready_ = false;
+  bool system_jacobian_ = false;  // jacobian_callback passed to the package
+  long jac_dq_points_ = 0;        // Jacobians by difference quotients where the system gave none
   std::string callback_failure_, solver_message_;
 
  private:

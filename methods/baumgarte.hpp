@@ -9,8 +9,9 @@
 #pragma once
 
 #include "core/format.hpp"
-#include "methods/mechanical_method.hpp"
 #include "linalg/small_linalg.hpp"
+#include "methods/mechanical_method.hpp"
+#include "methods/ode_jacobian.hpp"
 
 namespace cstab {
 
@@ -39,12 +40,27 @@ class BaumgarteFormulation final : public MechanicalFormulationBase<Model> {
                          format_3g(solver_.pivot_ratio()) + ") at t = " + std::to_string(t);
         return false;
       }
-      Vec<double, nc> g = terms_.gamma;  // A a + g = 0 with g = gamma + stab
-      if constexpr (nh > 0)
-        g.template head<nh>() += 2 * alpha_ * terms_.velocity.template head<nh>() + beta_ * beta_ * terms_.phi;
-      if constexpr (nc > nh)
-        g.template tail<nc - nh>() += gamma_ * terms_.velocity.template tail<nc - nh>();
-      vmap<nq>(dydt + nq) = solver_.accelerations(terms_.Q, g);
+      vmap<nq>(dydt + nq) = solver_.accelerations(terms_.Q, stabilized_rows());
+    }
+    return true;
+  }
+
+  // By AD through the KKT system (methods/ode_jacobian.hpp).
+  bool has_jacobian() const override { return true; }
+  bool jacobian(double t, const double* y, double* J) override {
+    const VecQ q = vmap<nq>(y), v = vmap<nq>(y + nq);
+    terms_.evaluate(this->model_, t, q, v, false);
+    using VecC = Vec<double, nc>;
+    if constexpr (nc == 0) {
+      if (!mass_.factor(terms_.M)) return false;
+      jac_.evaluate(this->model_, t, q, v, mass_.solve(terms_.Q), VecC(), 0, 0, 0);
+      jac_.fill(J, [&](const VecQ& r, const VecC&) { return VecQ(-mass_.solve(r)); });
+    } else {
+      if (solver_.factor(terms_.M, terms_.A, 1e-15) != SchurSolver<nq, nc>::Status::kOk) return false;
+      VecC lambda;
+      const VecQ a = solver_.accelerations(terms_.Q, stabilized_rows(), &lambda);
+      jac_.evaluate(this->model_, t, q, v, a, lambda, 2 * alpha_, beta_ * beta_, gamma_);
+      jac_.fill(J, [&](const VecQ& r, const VecC& g) { return solver_.accelerations(-r, g); });
     }
     return true;
   }
@@ -55,8 +71,18 @@ class BaumgarteFormulation final : public MechanicalFormulationBase<Model> {
     return false;
   }
 
+  // A a + g = 0 with g = gamma + stab, from terms_.
+  Vec<double, nc> stabilized_rows() const {
+    Vec<double, nc> g = terms_.gamma;
+    if constexpr (nh > 0)
+      g.template head<nh>() += 2 * alpha_ * terms_.velocity.template head<nh>() + beta_ * beta_ * terms_.phi;
+    if constexpr (nc > nh) g.template tail<nc - nh>() += gamma_ * terms_.velocity.template tail<nc - nh>();
+    return g;
+  }
+
   double alpha_, beta_, gamma_;
   MechanicalTerms<Model> terms_;
+  IndexOneJacobian<Model> jac_;
   // The KKT system [M A^T; A 0] [a; N] = [Q; -gamma - stab], solved by its
   // Schur complement A M^-1 A^T (M positive definite, A full rank).
   SchurSolver<nq, (nc > 0 ? nc : 1)> solver_;

@@ -11,9 +11,10 @@
 
 #include <cmath>
 
-#include "methods/mechanical_method.hpp"
 #include "linalg/small_linalg.hpp"
 #include "linalg/weighted_pinv.hpp"
+#include "methods/mechanical_method.hpp"
+#include "methods/ode_jacobian.hpp"
 
 namespace cstab {
 
@@ -26,7 +27,10 @@ class IndexOneFormulation : public MechanicalFormulationBase<Model> {
   using VecC = Vec<double, nc>;
 
   IndexOneFormulation(const Model& model, bool project, double tol, int max_iter)
-      : Base(model), project_(project), tol_(tol), max_iter_(max_iter) {}
+      : Base(model), project_(project), tol_(tol), max_iter_(max_iter) {
+    int rows = 0;
+    full_rank_ = initial_constraint_rank(model, &rows) == rows;
+  }
 
   bool rhs(double t, const double* y, double* dydt) override {
     const VecQ q = vmap<nq>(y), v = vmap<nq>(y + nq);
@@ -53,6 +57,31 @@ class IndexOneFormulation : public MechanicalFormulationBase<Model> {
     }
     vmap<nq>(dydt) = v;
     vmap<nq>(dydt + nq) = a;
+    return true;
+  }
+
+  // By AD (methods/ode_jacobian.hpp) where the rows have full rank. With
+  // redundant rows the multipliers are not unique, and the derivative of
+  // A^T lambda at fixed lambda depends on the choice: a model whose rows are
+  // redundant at the start gets none (the integrator's difference
+  // quotients), and so does a point where the Schur complement is nearly
+  // singular (pivot ratio below 1e-8).
+  bool has_jacobian() const override { return full_rank_; }
+  bool jacobian(double t, const double* y, double* J) override {
+    if (!full_rank_) return false;
+    const VecQ q = vmap<nq>(y), v = vmap<nq>(y + nq);
+    terms_.evaluate(this->model_, t, q, v, false);
+    if constexpr (nc > 0) {
+      if (schur_.factor(terms_.M, terms_.A, 1e-8) != SchurSolver<nq, nc>::Status::kOk) return false;
+      VecC lambda;
+      const VecQ a = schur_.accelerations(terms_.Q, terms_.gamma, &lambda);
+      jac_.evaluate(this->model_, t, q, v, a, lambda, 0, 0, 0);
+      jac_.fill(J, [&](const VecQ& r, const VecC& g) { return schur_.accelerations(-r, g); });
+    } else {
+      if (!mass_.factor(terms_.M)) return false;
+      jac_.evaluate(this->model_, t, q, v, mass_.solve(terms_.Q), VecC(), 0, 0, 0);
+      jac_.fill(J, [&](const VecQ& r, const VecC&) { return VecQ(-mass_.solve(r)); });
+    }
     return true;
   }
 
@@ -91,9 +120,11 @@ class IndexOneFormulation : public MechanicalFormulationBase<Model> {
   }
 
   bool project_;
+  bool full_rank_ = true;  // the constraint rows at the initial state
   double tol_;
   int max_iter_;
   MechanicalTerms<Model> terms_, pos_terms_, vel_terms_;
+  IndexOneJacobian<Model> jac_;
   Eigen::Matrix<double, nq, nq> M_;
   MassFactor<nq> mass_, post_mass_;
   SchurSolver<nq, (nc > 0 ? nc : 1)> schur_;

@@ -6,7 +6,10 @@
 //                            schemes' Newton iterations
 //                            (methods/newton_terms.hpp);
 //   ConsistentStart<Model>   consistent q, v and the KKT accelerations and
-//                            multipliers at t0 (methods/consistent_start.hpp).
+//                            multipliers at t0 (methods/consistent_start.hpp);
+//   AccelerationRowTerms<Model>  the derivatives of the acceleration-level
+//                            rows, for the index-1 methods' AD Jacobians
+//                            (methods/ode_jacobian.hpp).
 // A problem's header declares them after its model class, inside namespace
 // cstab, with CSTAB_EXTERN_MODEL_TEMPLATES(Model); its CMakeLists.txt has
 // them instantiated with cstab_model(Model HEADER) (cmake/cstab_catalog.cmake).
@@ -17,8 +20,10 @@
 #include "methods/consistent_start.hpp"
 #include "methods/mechanical.hpp"
 #include "methods/newton_terms.hpp"
+#include "methods/ode_jacobian.hpp"
 
 #define CSTAB_EXTERN_MODEL_TEMPLATES(Model)               \
   extern template struct ::cstab::MechanicalTerms<Model>; \
   extern template struct ::cstab::NewtonTerms<Model>;     \
-  extern template struct ::cstab::ConsistentStart<Model>
+  extern template struct ::cstab::ConsistentStart<Model>; \
+  extern template struct ::cstab::AccelerationRowTerms<Model>

@@ -23,8 +23,9 @@
 
 #include <algorithm>
 
-#include "methods/mechanical_method.hpp"
 #include "linalg/small_linalg.hpp"
+#include "methods/mechanical_method.hpp"
+#include "methods/ode_jacobian.hpp"
 
 namespace cstab {
 
@@ -56,31 +57,66 @@ class PenaltyFormulation final : public MechanicalFormulationBase<Model> {
     const VecQ q = vmap<nq>(y), v = vmap<nq>(y + nq);
     terms_.evaluate(this->model_, t, q, v, false);
     vmap<nq>(dydt) = v;
-    VecQ rhs = terms_.Q;
-    W_ = terms_.M;
-    if constexpr (nc > 0) {
-      Vec<double, nc> g = terms_.gamma;  // Phi'' = A a + g (and Psi' likewise), with the stabilization
-      const double w = settings_.omega;
-      if constexpr (nh > 0)
-        g.template head<nh>() += 2 * settings_.xi * w * terms_.velocity.template head<nh>() + w * w * terms_.phi;
-      if constexpr (nc > nh) g.template tail<nc - nh>() += w * terms_.velocity.template tail<nc - nh>();
-      W_.noalias() += penalty_ * terms_.A.transpose() * terms_.A;
-      rhs.noalias() -= penalty_ * terms_.A.transpose() * g;
-    }
-    if (!chol_.factor(W_)) {
-      this->failure_ = "M + p A^T A not positive definite at t = " + std::to_string(t);
-      return false;
-    }
-    vmap<nq>(dydt + nq) = chol_.solve(rhs);
+    VecQ a;
+    if (!accelerations(t, a)) return false;
+    vmap<nq>(dydt + nq) = a;
+    return true;
+  }
+
+  // By AD (methods/ode_jacobian.hpp): with lambda = -p (A a + g), the
+  // accelerations solve r = M a - Q - A^T lambda = 0, so
+  // (M + p A^T A) a_x = -(r_x + p A^T g_x) at fixed (a, lambda).
+  bool has_jacobian() const override { return true; }
+  bool jacobian(double t, const double* y, double* J) override {
+    const VecQ q = vmap<nq>(y), v = vmap<nq>(y + nq);
+    terms_.evaluate(this->model_, t, q, v, false);
+    VecQ a;
+    if (!accelerations(t, a)) return false;
+    using VecC = Vec<double, nc>;
+    VecC lambda;
+    if constexpr (nc > 0) lambda = -penalty_ * (terms_.A.lazyProduct(a) + stabilized_rows());
+    const double w = settings_.omega;
+    jac_.evaluate(this->model_, t, q, v, a, lambda, 2 * settings_.xi * w, w * w, w);
+    jac_.fill(J, [&](const VecQ& r, const VecC& g) {
+      if constexpr (nc > 0) return VecQ(-chol_.solve(r + penalty_ * terms_.A.transpose() * g));
+      return VecQ(-chol_.solve(r));
+    });
     return true;
   }
 
   double penalty() const { return penalty_; }
 
  private:
+  // Phi'' = A a + g (and Psi' likewise), g with the stabilization, from terms_.
+  Vec<double, nc> stabilized_rows() const {
+    Vec<double, nc> g = terms_.gamma;
+    const double w = settings_.omega;
+    if constexpr (nh > 0)
+      g.template head<nh>() += 2 * settings_.xi * w * terms_.velocity.template head<nh>() + w * w * terms_.phi;
+    if constexpr (nc > nh) g.template tail<nc - nh>() += w * terms_.velocity.template tail<nc - nh>();
+    return g;
+  }
+
+  // a from (M + p A^T A) a = Q - p A^T g at terms_; factors chol_.
+  bool accelerations(double t, VecQ& a) {
+    VecQ rhs = terms_.Q;
+    W_ = terms_.M;
+    if constexpr (nc > 0) {
+      W_.noalias() += penalty_ * terms_.A.transpose() * terms_.A;
+      rhs.noalias() -= penalty_ * terms_.A.transpose() * stabilized_rows();
+    }
+    if (!chol_.factor(W_)) {
+      this->failure_ = "M + p A^T A not positive definite at t = " + std::to_string(t);
+      return false;
+    }
+    a = chol_.solve(rhs);
+    return true;
+  }
+
   PenaltySettings settings_;
   double penalty_ = 0;  // p, force per unit (acceleration-level) violation
   MechanicalTerms<Model> terms_;
+  IndexOneJacobian<Model> jac_;
   Eigen::Matrix<double, nq, nq> W_;
   SmallCholesky<nq> chol_;
 };
