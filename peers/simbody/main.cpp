@@ -2,7 +2,7 @@
 // one of Simbody's integrators at a given accuracy and constraint tolerance,
 // and written as a trajectory `cstab score` reads (docs/peers-simbody.md).
 //
-//   cstab-peer-simbody --problem pendulum|slider-crank|bricard|andrews
+//   cstab-peer-simbody --problem pendulum|slider-crank|bricard|andrews|car-axis
 //       [--problem-param k=v[,k=v]] [--closure redundant|independent]
 //       --integrator rk3|rkmerson|rkfeldberg|verlet|euler|cpodes --accuracy A
 //       [--constraint-tolerance C] [--t-end T] [--every DT] --out FILE.csv
@@ -10,8 +10,9 @@
 // The program is deliberately independent of cstab's code: it restates the
 // problems' parameters (problems/pendulum/pendulum.hpp,
 // problems/slider_crank/slider_crank.hpp, problems/bricard/bricard.hpp,
-// problems/andrews/andrews.hpp) the way an outside user would, and
-// tests/peers/test_simbody.cpp checks that the two agree.
+// problems/andrews/andrews.hpp, problems/car_axis/car_axis.hpp) the way an
+// outside user would, and tests/peers/test_simbody.cpp checks that the two
+// agree.
 //
 // Exit codes: 0 done; 1 Simbody failed during integration (the rows up to the
 // failure are written, the error printed); 2 bad input (one line, nothing run).
@@ -63,7 +64,7 @@ struct Options {
 };
 
 const char* kUsage =
-    "usage: cstab-peer-simbody --problem pendulum|slider-crank|bricard|andrews [--problem-param k=v[,k=v]] "
+    "usage: cstab-peer-simbody --problem pendulum|slider-crank|bricard|andrews|car-axis [--problem-param k=v[,k=v]] "
     "--integrator rk3|rkmerson|rkfeldberg|verlet|euler|cpodes [--accuracy A (1e-3)] "
     "[--closure redundant|independent (bricard; redundant)] "
     "[--constraint-tolerance C (0.1 A)] [--t-end T (10)] [--every DT (0.01)] --out FILE.csv";
@@ -110,9 +111,10 @@ Options parse(int argc, char** argv) {
     }
   }
   (void)have_accuracy;
-  if (o.problem.empty()) bad("--problem is required (pendulum, slider-crank, bricard or andrews)");
-  if (o.problem != "pendulum" && o.problem != "slider-crank" && o.problem != "bricard" && o.problem != "andrews")
-    bad("--problem: '" + o.problem + "' is not modelled (pendulum, slider-crank, bricard, andrews)");
+  if (o.problem.empty()) bad("--problem is required (pendulum, slider-crank, bricard, andrews or car-axis)");
+  if (o.problem != "pendulum" && o.problem != "slider-crank" && o.problem != "bricard" && o.problem != "andrews" &&
+      o.problem != "car-axis")
+    bad("--problem: '" + o.problem + "' is not modelled (pendulum, slider-crank, bricard, andrews, car-axis)");
   if (!o.closure.empty() && o.problem != "bricard") bad("--closure: only bricard has a choice of loop closure");
   if (o.closure.empty() && o.problem == "bricard") o.closure = "redundant";
   if (o.problem == "bricard" && o.closure != "redundant" && o.closure != "independent")
@@ -143,6 +145,9 @@ struct Model {
   virtual std::vector<std::string> columns() const = 0;
   virtual void initial_state(State& s) const = 0;
   virtual void canonical(const State& s, double* c) const = 0;
+  // d/dt of the canonical velocities at s (realized to Acceleration), for the
+  // test against cstab's; empty where a model does not report them.
+  virtual std::vector<double> accelerations(const State&) const { return {}; }
 };
 
 // cstab's `pendulum`: a point mass m on a massless rod of length L pivoted at
@@ -429,6 +434,150 @@ struct AndrewsModel : Model {
   }
 };
 
+// cstab's `car-axis` (the IVP Test Set's caraxis, problems/car_axis/car_axis.hpp):
+// two wheel points l = (xl, yl) and r = (xr, yr) of mass k = M eps^2 / 2 in the
+// plane, joined by an axle of length L; a spring (stiffness 1, free length
+// L0) from the origin to l and another from the moving bump
+// b(t) = (xb, yb), yb = r sin(w t), xb = sqrt(L^2 - yb^2), to r; gravity g
+// along -y. Constraints: Phi1 = xb(t) xl + yb(t) yl = 0 (l stays on the line
+// through the origin normal to b(t)) and the axle's length.
+//
+// In Simbody each wheel point moves on a Cartesian pair of sliders as the
+// pendulum's bob (x carriage massless, the y slider carrying k). The axle is
+// a Constraint::Rod of length L between the two points; Phi1, which moves
+// with time, is a Constraint::Custom on the left pair's q (RoadConstraint:
+// its position error is Phi1 itself, its first and second time derivatives
+// include the explicit ones through b(t), its force is lambda dPhi1/dq as
+// Simbody's own CoordinateCoupler and PrescribedMotion apply theirs). The
+// left spring is a Force::TwoPointLinearSpring from the ground origin; the
+// right one, anchored at the moving bump, a Force::Custom (BumpSpring).
+struct CarAxisParams {
+  double eps = 1e-2, M = 10, L = 1, L0 = 0.5, r = 0.1, w = 10, g = 1;  // as CarAxisParameters
+  double k() const { return M * eps * eps / 2; }
+  // b(t) and its first two time derivatives.
+  void bump(double t, double& xb, double& yb, double& xb1, double& yb1, double& xb2, double& yb2) const {
+    yb = r * std::sin(w * t);
+    xb = std::sqrt(L * L - yb * yb);
+    yb1 = r * w * std::cos(w * t);
+    xb1 = -yb * yb1 / xb;
+    yb2 = -w * w * yb;
+    xb2 = -(xb1 * xb1 + yb1 * yb1 + yb * yb2) / xb;
+  }
+};
+
+class RoadConstraint : public Constraint::Custom::Implementation {
+ public:
+  RoadConstraint(SimbodyMatterSubsystem& matter, const CarAxisParams& p, const MobilizedBody& x, const MobilizedBody& y)
+      : Implementation(matter, 1, 0, 0), p_(p), x_(addConstrainedMobilizer(x)), y_(addConstrainedMobilizer(y)) {}
+  Implementation* clone() const override { return new RoadConstraint(*this); }
+
+  void calcPositionErrors(const State& s, const Array_<Transform, ConstrainedBodyIndex>&,
+                          const Array_<Real, ConstrainedQIndex>& q, Array_<Real>& perr) const override {
+    double xb, yb, xb1, yb1, xb2, yb2;
+    p_.bump(s.getTime(), xb, yb, xb1, yb1, xb2, yb2);
+    perr[0] = xb * getOneQ(s, q, x_, kQ) + yb * getOneQ(s, q, y_, kQ);
+  }
+  void calcPositionDotErrors(const State& s, const Array_<SpatialVec, ConstrainedBodyIndex>&,
+                             const Array_<Real, ConstrainedQIndex>& qdot, Array_<Real>& pverr) const override {
+    double xb, yb, xb1, yb1, xb2, yb2;
+    p_.bump(s.getTime(), xb, yb, xb1, yb1, xb2, yb2);
+    const double xl = getOneQFromState(s, x_, kQ), yl = getOneQFromState(s, y_, kQ);
+    pverr[0] = xb1 * xl + yb1 * yl + xb * getOneQDot(s, qdot, x_, kQ) + yb * getOneQDot(s, qdot, y_, kQ);
+  }
+  void calcPositionDotDotErrors(const State& s, const Array_<SpatialVec, ConstrainedBodyIndex>&,
+                                const Array_<Real, ConstrainedQIndex>& qdotdot, Array_<Real>& paerr) const override {
+    double xb, yb, xb1, yb1, xb2, yb2;
+    p_.bump(s.getTime(), xb, yb, xb1, yb1, xb2, yb2);
+    const double xl = getOneQFromState(s, x_, kQ), yl = getOneQFromState(s, y_, kQ);
+    const double vx = getOneQDotFromState(s, x_, kQ), vy = getOneQDotFromState(s, y_, kQ);
+    paerr[0] = xb2 * xl + yb2 * yl + 2 * (xb1 * vx + yb1 * vy) + xb * getOneQDotDot(s, qdotdot, x_, kQ) +
+               yb * getOneQDotDot(s, qdotdot, y_, kQ);
+  }
+  void addInPositionConstraintForces(const State& s, const Array_<Real>& multipliers,
+                                     Array_<SpatialVec, ConstrainedBodyIndex>&,
+                                     Array_<Real, ConstrainedQIndex>& qForces) const override {
+    double xb, yb, xb1, yb1, xb2, yb2;
+    p_.bump(s.getTime(), xb, yb, xb1, yb1, xb2, yb2);
+    addInOneQForce(s, x_, kQ, multipliers[0] * xb, qForces);
+    addInOneQForce(s, y_, kQ, multipliers[0] * yb, qForces);
+  }
+
+ private:
+  static const MobilizerQIndex kQ;
+  CarAxisParams p_;
+  ConstrainedMobilizerIndex x_, y_;
+};
+
+const MobilizerQIndex RoadConstraint::kQ(0);  // a Slider's only q
+
+class BumpSpring : public Force::Custom::Implementation {
+ public:
+  BumpSpring(const CarAxisParams& p, const MobilizedBody& wheel) : p_(p), wheel_(wheel) {}
+  void calcForce(const State& s, Vector_<SpatialVec>& bodyForces, Vector_<Vec3>&, Vector&) const override {
+    Vec3 d;
+    double len;
+    stretch(s, d, len);
+    wheel_.applyForceToBodyPoint(s, Vec3(0), (p_.L0 - len) / len * d, bodyForces);
+  }
+  Real calcPotentialEnergy(const State& s) const override {
+    Vec3 d;
+    double len;
+    stretch(s, d, len);
+    return 0.5 * (len - p_.L0) * (len - p_.L0);
+  }
+
+ private:
+  // The wheel point less the bump point, and its length.
+  void stretch(const State& s, Vec3& d, double& len) const {
+    double xb, yb, xb1, yb1, xb2, yb2;
+    p_.bump(s.getTime(), xb, yb, xb1, yb1, xb2, yb2);
+    d = wheel_.getBodyOriginLocation(s) - Vec3(xb, yb, 0);
+    len = d.norm();
+  }
+  CarAxisParams p_;
+  MobilizedBody wheel_;
+};
+
+struct CarAxisModel : Model {
+  CarAxisParams p;
+  MobilizedBody::Slider sxl, syl, sxr, syr;
+
+  explicit CarAxisModel(const std::map<std::string, std::string>& params) {
+    if (!params.empty()) bad("--problem-param: car-axis has no parameters ('" + params.begin()->first + "')");
+    Force::UniformGravity(forces, matter, Vec3(0, -p.g, 0));
+    const Transform along_y(Rotation(Pi / 2, ZAxis));
+    const Body::Rigid wheel(MassProperties(p.k(), Vec3(0), Inertia(0)));
+    sxl = MobilizedBody::Slider(matter.Ground(), Transform(), Body::Massless(), Transform());
+    syl = MobilizedBody::Slider(sxl, along_y, wheel, along_y);
+    sxr = MobilizedBody::Slider(matter.Ground(), Transform(), Body::Massless(), Transform());
+    syr = MobilizedBody::Slider(sxr, along_y, wheel, along_y);
+    Constraint::Custom(new RoadConstraint(matter, p, sxl, syl));
+    Constraint::Rod(syl, Vec3(0), syr, Vec3(0), p.L);
+    Force::TwoPointLinearSpring(forces, matter.Ground(), Vec3(0), syl, Vec3(0), 1.0, p.L0);
+    Force::Custom(forces, new BumpSpring(p, syr));
+  }
+  std::vector<std::string> columns() const override {
+    return {"xl", "yl", "xr", "yr", "xldot", "yldot", "xrdot", "yrdot"};
+  }
+  void initial_state(State& s) const override {
+    // The Test Set's consistent initial values.
+    const double q0[4] = {0, p.L0, p.L, p.L0}, u0[4] = {-p.L0 / p.L, 0, -p.L0 / p.L, 0};
+    const MobilizedBody::Slider* m[4] = {&sxl, &syl, &sxr, &syr};
+    for (int i = 0; i < 4; ++i) {
+      m[i]->setOneQ(s, 0, q0[i]);
+      m[i]->setOneU(s, 0, u0[i]);
+    }
+  }
+  void canonical(const State& s, double* c) const override {
+    const MobilizedBody::Slider* m[4] = {&sxl, &syl, &sxr, &syr};
+    for (int i = 0; i < 4; ++i) c[i] = m[i]->getOneQ(s, 0), c[4 + i] = m[i]->getOneU(s, 0);
+  }
+  std::vector<double> accelerations(const State& s) const override {
+    system.realize(s, Stage::Acceleration);
+    return {sxl.getOneUDot(s, 0), syl.getOneUDot(s, 0), sxr.getOneUDot(s, 0), syr.getOneUDot(s, 0)};
+  }
+};
+
 std::unique_ptr<Integrator> make_integrator(const std::string& name, const System& system) {
   if (name == "rk3") return std::make_unique<RungeKutta3Integrator>(system);
   if (name == "rkmerson") return std::make_unique<RungeKuttaMersonIntegrator>(system);
@@ -461,8 +610,10 @@ int main(int argc, char** argv) {
       model = std::make_unique<SliderCrankModel>(o.params);
     else if (o.problem == "bricard")
       model = std::make_unique<BricardModel>(o.params, o.closure == "redundant");
-    else
+    else if (o.problem == "andrews")
       model = std::make_unique<AndrewsModel>(o.params);
+    else
+      model = std::make_unique<CarAxisModel>(o.params);
     out.open(o.out);
     if (!out) bad("--out: cannot write '" + o.out + "'");
   } catch (const BadInput& e) {
@@ -482,10 +633,11 @@ int main(int argc, char** argv) {
 
   std::string error;
   double wall = 0, energy0 = std::nan("");
+  std::vector<double> accelerations0, accelerations_end;
   double accuracy_in_use = std::nan(""), tolerance_in_use = std::nan("");
   long steps = 0, attempts = 0, q_projections = 0, u_projections = 0, realizations = 0;
   std::unique_ptr<Integrator> integ;
-  State initial;
+  State initial, last;
   try {
     model->system.realizeTopology();
     State state = model->system.getDefaultState();
@@ -515,6 +667,7 @@ int main(int argc, char** argv) {
         if (t == o.t_end) break;
       }
       stop_clock();
+      last = integ->getState();
     } catch (...) {
       stop_clock();
       throw;
@@ -540,6 +693,9 @@ int main(int argc, char** argv) {
     try {
       model->system.realize(initial, Stage::Dynamics);
       energy0 = model->system.calcEnergy(initial);
+      accelerations0 = model->accelerations(initial);
+      // And of the last row's state, after a complete run.
+      if (error.empty()) accelerations_end = model->accelerations(last);
     } catch (const std::exception&) {
     }
   }
@@ -561,6 +717,14 @@ int main(int argc, char** argv) {
   out << "# simbody_u_projections = " << u_projections << "\n";
   out << "# simbody_realizations = " << realizations << "\n";
   out << "# simbody_initial_energy = " << g17(energy0) << "\n";
+  auto list = [&](const char* key, const std::vector<double>& values) {
+    if (values.empty()) return;
+    out << "# " << key << " =";
+    for (size_t i = 0; i < values.size(); ++i) out << (i ? "," : " ") << g17(values[i]);
+    out << "\n";
+  };
+  list("simbody_initial_accelerations", accelerations0);
+  list("simbody_final_accelerations", accelerations_end);
   if (!error.empty()) out << "# simbody_error = " << error << "\n";
   out << "t";
   for (const auto& name : columns) out << "," << name;

@@ -1,7 +1,9 @@
 // cstab-peer-simbody (peers/simbody/) against cstab's own problems: the state
 // it writes at t = 0 and Simbody's initial energy equal cstab's to round-off,
 // its runs score within a bound set by the constraint tolerance, and bad
-// input or a Simbody failure ends as documented. CSTAB_PEER_SIMBODY is defined
+// input or a Simbody failure ends as documented. For the car axis, which has
+// no energy law, Simbody's accelerations at the first and the last row equal
+// those of cstab's equations of motion at the same state. CSTAB_PEER_SIMBODY is defined
 // by peers/simbody/CMakeLists.txt when the adapter is built; without Simbody
 // every test here skips.
 #include <gtest/gtest.h>
@@ -20,6 +22,7 @@
 
 #include "problems/andrews/andrews.hpp"
 #include "problems/bricard/bricard.hpp"
+#include "problems/car_axis/car_axis.hpp"
 #include "problems/pendulum/pendulum.hpp"
 #include "problems/slider_crank/slider_crank.hpp"
 
@@ -383,6 +386,115 @@ TEST(SimbodyPeer, AndrewsScoredRunFollowsCstabsReference) {
   EXPECT_LT(std::stod(rows[1e-6].at("max_energy_drift")), 1e-3);
 }
 
+// cstab's car axis accelerations at (t, q, v): M a = Q + A^T lambda with
+// A a + gamma = 0 (methods/mechanical.hpp), solved as one KKT system.
+std::vector<double> car_axis_accelerations(double t, const double* c) {
+  const cstab::CarAxis problem;
+  cstab::Vec<double, 4> q, v;
+  for (int i = 0; i < 4; ++i) q(i) = c[i], v(i) = c[4 + i];
+  cstab::MechanicalTerms<cstab::CarAxisMechanical> terms;
+  terms.evaluate(problem.mechanical(), t, q, v, false);
+  Eigen::Matrix<double, 6, 6> kkt = Eigen::Matrix<double, 6, 6>::Zero();
+  kkt.topLeftCorner<4, 4>() = terms.M;
+  kkt.topRightCorner<4, 2>() = terms.A.transpose();
+  kkt.bottomLeftCorner<2, 4>() = terms.A;
+  Eigen::Matrix<double, 6, 1> rhs;
+  rhs << terms.Q, -terms.gamma;
+  const Eigen::Matrix<double, 6, 1> x = kkt.fullPivLu().solve(rhs);
+  return {x(0), x(1), x(2), x(3)};
+}
+
+std::vector<double> numbers(const std::string& list) {
+  std::vector<double> out;
+  for (const auto& cell : split(list)) out.push_back(std::stod(cell));
+  return out;
+}
+
+// The car axis (IVP Test Set): the columns are cstab's coordinates, the first
+// row is the Test Set's initial state exactly, and Simbody's energy of it
+// (kinetic, gravity's k g y, and both springs' (l - L0)^2 / 2, zero at the
+// start) is the same restated from cstab's parameters. The start is at rest
+// in every force but gravity (both springs at their free length, no
+// constraint force), so the accelerations are also compared at the run's
+// last row, (t, q, v) = the written values (%.17g, read back exactly): there
+// the springs, the moving bump and both constraints' forces all act, and
+// Simbody's udot equals cstab's KKT solution to round-off (measured 3e-14
+// relative here, 1.4e-16 at t = 3; 3e-10 at accuracy 1e-3, where the state
+// is further off the constraints and the two formulations' rows differ
+// there).
+TEST(SimbodyPeer, CarAxisStartsAtCstabsStateAndAccelerations) {
+  REQUIRE_PEER();
+  const cstab::CarAxis problem;
+  const cstab::CarAxisParameters p;
+  const fs::path csv = scratch("car-axis-start.csv");
+  const Outcome o = peer("--problem car-axis --integrator rkmerson --accuracy 1e-9 --t-end 0.5 --every 0.1 --out '" +
+                         csv.string() + "'");
+  ASSERT_EQ(o.code, 0) << o.out;
+  const Trajectory tr = read(csv);
+  std::vector<std::string> columns = {"t"};
+  for (const auto& name : problem.info().coordinates) columns.push_back(name);
+  ASSERT_EQ(tr.columns, columns);
+  ASSERT_EQ(tr.rows.size(), 6u);
+  cstab::Vec<double, 4> q, v;
+  problem.mechanical().initial_state(q, v);
+  double c[8];
+  problem.mechanical().to_canonical(0.0, q, v, c);
+  EXPECT_EQ(tr.rows[0][0], 0.0);
+  for (int i = 0; i < 8; ++i) EXPECT_NEAR(tr.rows[0][i + 1], c[i], 4 * kEps) << columns[i + 1];
+
+  const double k = p.k(), g = p.g, L0 = p.L0;
+  const double ll = std::hypot(c[0], c[1]), lr = std::hypot(c[2] - p.L, c[3]);  // the bump is at (L, 0) at t = 0
+  const double e_cstab = 0.5 * k * (c[4] * c[4] + c[5] * c[5] + c[6] * c[6] + c[7] * c[7]) + k * g * (c[1] + c[3]) +
+                         0.5 * (ll - L0) * (ll - L0) + 0.5 * (lr - L0) * (lr - L0);
+  const double e_simbody = std::stod(tr.meta.at("simbody_initial_energy"));
+  EXPECT_NEAR(e_cstab, 6.25e-4, 1e-15);
+  EXPECT_NEAR(e_simbody, e_cstab, 16 * kEps * e_cstab) << "cstab " << e_cstab << ", Simbody " << e_simbody;
+
+  const std::vector<double> a0 = car_axis_accelerations(0.0, c);
+  const std::vector<double> a0_simbody = numbers(tr.meta.at("simbody_initial_accelerations"));
+  ASSERT_EQ(a0_simbody.size(), 4u);
+  for (int i = 0; i < 4; ++i) EXPECT_NEAR(a0_simbody[i], a0[i], 16 * kEps * p.g) << columns[i + 1];
+
+  const std::vector<double>& last = tr.rows.back();
+  EXPECT_EQ(last[0], 0.5);
+  const std::vector<double> a1 = car_axis_accelerations(last[0], last.data() + 1);
+  const std::vector<double> a1_simbody = numbers(tr.meta.at("simbody_final_accelerations"));
+  ASSERT_EQ(a1_simbody.size(), 4u);
+  double scale = 1;
+  for (const double a : a1) scale = std::max(scale, std::abs(a));
+  EXPECT_GT(scale, 2.0);  // more than gravity acts
+  for (int i = 0; i < 4; ++i) EXPECT_NEAR(a1_simbody[i], a1[i], 1e-11 * scale) << columns[i + 1];
+}
+
+// The car axis over the Test Set's [0, 3], rows every 0.1 s (as the peers
+// matrix), scored against its published solution at t = 3: the residual of
+// cstab's two rows stays within 10x the constraint tolerance (measured up to
+// 2.7x: the axle row is about 2 L times the length error Simbody's Rod
+// measures) and shrinks from accuracy 1e-3 to 1e-6 (2.7e-4 to 2.7e-7), and
+// at 1e-9 the run ends within 1e-5 of the reference (measured 2.2e-6).
+TEST(SimbodyPeer, CarAxisScoredRunFollowsTheTestSetsSolution) {
+  REQUIRE_PEER();
+  std::map<double, std::map<std::string, std::string>> rows;
+  for (const double accuracy : {1e-3, 1e-6, 1e-9}) {
+    char acc[32];
+    std::snprintf(acc, sizeof acc, "%.17g", accuracy);
+    const std::string tag = std::string("car-axis-") + acc;
+    const fs::path csv = scratch(tag + ".csv"), dir = scratch(tag);
+    const Outcome o = peer(std::string("--problem car-axis --integrator rkmerson --accuracy ") + acc +
+                           " --t-end 3 --every 0.1 --out '" + csv.string() + "'");
+    ASSERT_EQ(o.code, 0) << o.out;
+    const Outcome s = score("car-axis", csv, dir);
+    ASSERT_EQ(s.code, 0) << s.out;
+    rows[accuracy] = summary(dir);
+    const auto& row = rows[accuracy];
+    EXPECT_EQ(row.at("status"), "ok") << tag;
+    EXPECT_LE(std::stod(row.at("initial_state_deviation")), 4 * kEps) << tag;
+    EXPECT_LE(std::stod(row.at("max_residual")), 10 * 0.1 * accuracy) << tag;
+  }
+  EXPECT_LT(std::stod(rows[1e-6].at("max_residual")), std::stod(rows[1e-3].at("max_residual")));
+  EXPECT_LT(std::stod(rows[1e-9].at("ref_error")), 1e-5);
+}
+
 TEST(SimbodyPeer, BadInputExitsTwoWithOneLine) {
   REQUIRE_PEER();
   const fs::path csv = scratch("bad.csv");
@@ -400,6 +512,8 @@ TEST(SimbodyPeer, BadInputExitsTwoWithOneLine) {
       "--problem bricard --integrator rk3 --closure loose" + out,
       "--problem andrews --integrator rk3 --problem-param c0=1" + out,
       "--problem andrews --integrator rk3 --closure redundant" + out,
+      "--problem car-axis --integrator rk3 --problem-param eps=0.1" + out,
+      "--problem car-axis --integrator rk3 --closure redundant" + out,
       "--problem pendulum --integrator rk3 --closure redundant" + out,
       "--problem pendulum --integrator rk3 --t-end -1" + out,
       "--problem pendulum --integrator rk3",
