@@ -362,18 +362,20 @@ TEST(SimbodyPeer, AndrewsStartsAtCstabsStateAndEnergy) {
 // the constraint tolerance, shrinks from accuracy 1e-3 to 1e-6, and at 1e-6
 // the run ends within 1e-3 of the reference with cstab's energy (torque
 // included) kept to 1e-3 of the spring's initial energy.
-TEST(SimbodyPeer, AndrewsScoredRunFollowsCstabsReference) {
-  REQUIRE_PEER();
-  std::map<double, std::map<std::string, std::string>> rows;
-  for (const double accuracy : {1e-3, 1e-6}) {
+// rkmerson on `problem` at each accuracy, each trajectory scored into
+// rows[accuracy], with what every scored run must show: status ok, the start
+// at cstab's state, the residual within 10x the constraint tolerance.
+void scored_rkmerson_runs(const std::string& problem, const std::vector<double>& accuracies, const std::string& t_end,
+                          const std::string& every, std::map<double, std::map<std::string, std::string>>& rows) {
+  for (const double accuracy : accuracies) {
     char acc[32];
     std::snprintf(acc, sizeof acc, "%.17g", accuracy);
-    const std::string tag = std::string("andrews-") + acc;
+    const std::string tag = problem + "-" + acc;
     const fs::path csv = scratch(tag + ".csv"), dir = scratch(tag);
-    const Outcome o = peer(std::string("--problem andrews --integrator rkmerson --accuracy ") + acc +
-                           " --t-end 0.03 --every 0.001 --out '" + csv.string() + "'");
+    const Outcome o = peer("--problem " + problem + " --integrator rkmerson --accuracy " + acc + " --t-end " + t_end +
+                           " --every " + every + " --out '" + csv.string() + "'");
     ASSERT_EQ(o.code, 0) << o.out;
-    const Outcome s = score("andrews", csv, dir);
+    const Outcome s = score(problem, csv, dir);
     ASSERT_EQ(s.code, 0) << s.out;
     rows[accuracy] = summary(dir);
     const auto& row = rows[accuracy];
@@ -381,6 +383,12 @@ TEST(SimbodyPeer, AndrewsScoredRunFollowsCstabsReference) {
     EXPECT_LE(std::stod(row.at("initial_state_deviation")), 4 * kEps) << tag;
     EXPECT_LE(std::stod(row.at("max_residual")), 10 * 0.1 * accuracy) << tag;
   }
+}
+
+TEST(SimbodyPeer, AndrewsScoredRunFollowsCstabsReference) {
+  REQUIRE_PEER();
+  std::map<double, std::map<std::string, std::string>> rows;
+  ASSERT_NO_FATAL_FAILURE(scored_rkmerson_runs("andrews", {1e-3, 1e-6}, "0.03", "0.001", rows));
   EXPECT_LT(std::stod(rows[1e-6].at("max_residual")), std::stod(rows[1e-3].at("max_residual")));
   EXPECT_LT(std::stod(rows[1e-6].at("ref_error")), 1e-3);
   EXPECT_LT(std::stod(rows[1e-6].at("max_energy_drift")), 1e-3);
@@ -475,22 +483,7 @@ TEST(SimbodyPeer, CarAxisStartsAtCstabsStateAndAccelerations) {
 TEST(SimbodyPeer, CarAxisScoredRunFollowsTheTestSetsSolution) {
   REQUIRE_PEER();
   std::map<double, std::map<std::string, std::string>> rows;
-  for (const double accuracy : {1e-3, 1e-6, 1e-9}) {
-    char acc[32];
-    std::snprintf(acc, sizeof acc, "%.17g", accuracy);
-    const std::string tag = std::string("car-axis-") + acc;
-    const fs::path csv = scratch(tag + ".csv"), dir = scratch(tag);
-    const Outcome o = peer(std::string("--problem car-axis --integrator rkmerson --accuracy ") + acc +
-                           " --t-end 3 --every 0.1 --out '" + csv.string() + "'");
-    ASSERT_EQ(o.code, 0) << o.out;
-    const Outcome s = score("car-axis", csv, dir);
-    ASSERT_EQ(s.code, 0) << s.out;
-    rows[accuracy] = summary(dir);
-    const auto& row = rows[accuracy];
-    EXPECT_EQ(row.at("status"), "ok") << tag;
-    EXPECT_LE(std::stod(row.at("initial_state_deviation")), 4 * kEps) << tag;
-    EXPECT_LE(std::stod(row.at("max_residual")), 10 * 0.1 * accuracy) << tag;
-  }
+  ASSERT_NO_FATAL_FAILURE(scored_rkmerson_runs("car-axis", {1e-3, 1e-6, 1e-9}, "3", "0.1", rows));
   EXPECT_LT(std::stod(rows[1e-6].at("max_residual")), std::stod(rows[1e-3].at("max_residual")));
   EXPECT_LT(std::stod(rows[1e-9].at("ref_error")), 1e-5);
 }
