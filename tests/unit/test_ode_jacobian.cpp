@@ -130,10 +130,11 @@ TEST_P(OdeJacobian, MatchesDifferenceQuotients) {
         if (err > worst) worst = err, worst_i = i, worst_j = j;
       }
     }
-    if (worst_i >= 0)
+    if (worst_i >= 0) {
       EXPECT_LT(worst, 1e-5) << "entry (" << worst_i << ", " << worst_j << "): AD " << J[worst_i + size_t(worst_j) * n]
                              << ", differences " << fd[worst_j][worst_i] << " (point "
                              << (checked == 0 ? "start" : "off") << ")";
+    }
     ++checked;
   }
   EXPECT_EQ(checked, 2);
@@ -192,7 +193,9 @@ TEST_P(SystemJacobian, SameSolutionAsDifferenceQuotients) {
     EXPECT_EQ(extra(ad, "jac_dq_points"), "0");
     EXPECT_NE(extra(dq, "cvode_jac_rhs_evals"), "0");
   }
-  if (c.integrator == "msbdf") EXPECT_NE(extra(ad, "msbdf_system_jacobians"), "0");
+  if (c.integrator == "msbdf") {
+    EXPECT_NE(extra(ad, "msbdf_system_jacobians"), "0");
+  }
 }
 
 INSTANTIATE_TEST_SUITE_P(Integrators, SystemJacobian,
