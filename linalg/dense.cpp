@@ -134,6 +134,19 @@ Lu& Lu::operator=(Lu&&) noexcept = default;
 
 int Lu::size() const { return impl_->n; }
 
+double Lu::pivot_ratio() const {
+  const int n = impl_->n;
+  if (n == 0) return 1;
+  double lo = std::numeric_limits<double>::infinity(), hi = 0;
+  for (int k = 0; k < n; ++k) {
+    const double u = std::abs(impl_->lu[std::size_t(k) * std::size_t(n) + std::size_t(k)]);
+    if (!(u == u)) return 0;  // NaN
+    lo = std::min(lo, u);
+    hi = std::max(hi, u);
+  }
+  return hi > 0 ? lo / hi : 0;
+}
+
 namespace {
 
 // The factorization and the solve for n rows; N > 0 fixes n at compile time

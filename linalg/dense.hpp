@@ -83,6 +83,9 @@ class Lu {
   void solve(const double* b, double* x) const;  // x = A^-1 b; x may alias b
   void solve_columns(const double* b, double* x, int columns) const;  // column-major n x columns; may alias
   int size() const;
+  // After compute(): min |u_ii| / max |u_ii| (0 if singular, 1 for n = 0):
+  // a cheap singularity indicator, as BandLu's (linalg/band.hpp).
+  double pivot_ratio() const;
 
  private:
   struct Impl;

@@ -105,6 +105,11 @@ struct BaumgarteMethod : MechanicalMethod<BaumgarteMethod> {
     return std::make_unique<BaumgarteFormulation<Model>>(model, params.get("alpha"), params.get("beta"),
                                                          params.get("gamma"));
   }
+  static ScalableSettings scalable_settings(const Params& params) {
+    return {.stabilization = ScalableSettings::Stabilization::kBaumgarte,
+            .alpha = params.get("alpha"),
+            .beta = params.get("beta")};
+  }
 };
 
 }  // namespace cstab

@@ -5,6 +5,9 @@
 //   MechanicalModel<M>  M(t,q) a = Q(t,q,v) + A^T lambda    (methods/mechanical.hpp)
 //   AffineModel<M>      X' = F(t,X) + B(t,X) N, outputs f   (methods/affine.hpp)
 //   MinimalModel<M>     the problem's own constraint-free ODE (methods/minimal.hpp)
+//   HasScalable<P>      P's scalable() is a runtime-size ScalableModel: a class
+//                       with virtual functions, checked by the compiler as such
+//                       (methods/scalable.hpp)
 //   ProblemClass<P>     a class in problems/<name>/ (or a test-local one)
 //   MethodType<M>       a method of the catalog (methods/pair.hpp)
 //   MethodFor<M, P>     M's why_not / params / make callable on P
@@ -44,6 +47,7 @@
 #include "methods/affine.hpp"
 #include "methods/contract_detail.hpp"
 #include "methods/mechanical.hpp"
+#include "methods/scalable.hpp"
 
 namespace cstab::contracts {
 
@@ -275,6 +279,12 @@ template <class P>
 concept HasStateSpace = detail::state_space_const<P> && detail::state_space_accessor_ok<P>();
 template <class P>
 concept HasMinimal = detail::minimal_const<P> && detail::minimal_accessor_ok<P>();
+
+// A runtime-size model (methods/scalable.hpp): a class derived from ScalableModel.
+template <class P>
+concept HasScalable = requires(const P& p) {
+  { p.scalable() } -> std::convertible_to<const ScalableModel&>;
+};
 
 template <class P>
 concept HasEnergy = detail::energy_exact<P>;

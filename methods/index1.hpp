@@ -144,6 +144,7 @@ struct NoneMethod : MechanicalMethod<NoneMethod> {
   static std::unique_ptr<Formulation> make_model(const Model& model, const Params&) {
     return std::make_unique<IndexOneFormulation<Model>>(model, false, 0.0, 0);
   }
+  static ScalableSettings scalable_settings(const Params&) { return {}; }
 };
 
 struct ProjectionMethod : MechanicalMethod<ProjectionMethod> {
@@ -160,6 +161,13 @@ struct ProjectionMethod : MechanicalMethod<ProjectionMethod> {
     const double max_iter = params.get("max_iter");
     if (max_iter != std::floor(max_iter)) throw UsageError("--param max_iter: must be an integer");
     return std::make_unique<IndexOneFormulation<Model>>(model, true, params.get("tol"), int(max_iter));
+  }
+  static ScalableSettings scalable_settings(const Params& params) {
+    const double max_iter = params.get("max_iter");
+    if (max_iter != std::floor(max_iter)) throw UsageError("--param max_iter: must be an integer");
+    return {.stabilization = ScalableSettings::Stabilization::kProjection,
+            .tol = params.get("tol"),
+            .max_iter = int(max_iter)};
   }
 };
 

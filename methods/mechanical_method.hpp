@@ -13,6 +13,7 @@
 #include "core/problem.hpp"
 #include "methods/contracts.hpp"
 #include "methods/mechanical.hpp"
+#include "methods/scalable.hpp"
 
 namespace cstab {
 
@@ -38,6 +39,13 @@ struct MechanicalMethod {
       std::string why = Derived::template why_not_model(p.mechanical());
       if (why.empty() && Derived::kNeedsFullRank) why = redundancy_why_not(p.mechanical(), Derived::kName);
       return why;
+    } else if constexpr (contracts::HasScalable<P>) {
+      if constexpr (runs_scalable()) {
+        return {};
+      } else {
+        return "runs on fixed-size models only, and this problem's size is a runtime parameter (the runtime-size "
+               "path runs none, baumgarte, projection and post-stabilization: methods/scalable.hpp)";
+      }
     } else {
       return "problem has no mechanical (M, Q, constraints) model";
     }
@@ -49,6 +57,10 @@ struct MechanicalMethod {
     check_formulation(p, formulation);
     if constexpr (contracts::HasMechanical<P>) {
       return Derived::template model_params(p.mechanical());
+    } else if constexpr (contracts::HasScalable<P>) {
+      std::vector<ParamSpec> specs = Derived::generic_params();
+      specs.push_back(scalable_kkt_param());
+      return specs;
     } else {
       return {};
     }
@@ -60,6 +72,10 @@ struct MechanicalMethod {
     check_formulation(p, formulation);
     if constexpr (contracts::HasMechanical<P>) {
       return Derived::template make_model(p.mechanical(), params);
+    } else if constexpr (contracts::HasScalable<P> && runs_scalable()) {
+      ScalableSettings settings = Derived::scalable_settings(params);
+      read_scalable_kkt(params, settings);
+      return make_scalable_formulation(p.scalable(), settings);
     } else {
       throw UsageError(std::string(Derived::kName) + ": problem has no mechanical model");
     }
@@ -67,6 +83,15 @@ struct MechanicalMethod {
 
   // Default: applies to every mechanical model, redundant rows included.
   static constexpr bool kNeedsFullRank = false;
+  // Methods that also run scalable models (methods/scalable.hpp) define
+  //   static ScalableSettings scalable_settings(const Params&);
+  // (A function, so that Derived is complete when it is asked.)
+  template <class D = Derived>
+  static constexpr bool runs_scalable() {
+    return requires(const Params& params) {
+      { D::scalable_settings(params) } -> std::same_as<ScalableSettings>;
+    };
+  }
   template <class Model>
   static std::string why_not_model(const Model&) { return {}; }
   template <class Model>
@@ -79,6 +104,10 @@ struct MechanicalMethod {
       if (!formulation.empty() && formulation != p.mechanical().formulation_name())
         throw UsageError("--formulation " + formulation + ": " + Derived::kName + " runs on '" +
                          p.mechanical().formulation_name() + "'");
+    } else if constexpr (contracts::HasScalable<P>) {
+      if (!formulation.empty() && formulation != p.scalable().formulation_name())
+        throw UsageError("--formulation " + formulation + ": " + Derived::kName + " runs on '" +
+                         p.scalable().formulation_name() + "'");
     }
   }
 };

@@ -134,6 +134,11 @@ struct PostStabilizationMethod : MechanicalMethod<PostStabilizationMethod> {
     if (refactor != 0 && refactor != 1) throw UsageError("--param refactor: must be 0 or 1");
     return std::make_unique<PostStabilizationFormulation<Model>>(model, refactor == 1);
   }
+  static ScalableSettings scalable_settings(const Params& params) {
+    const double refactor = params.get("refactor");
+    if (refactor != 0 && refactor != 1) throw UsageError("--param refactor: must be 0 or 1");
+    return {.stabilization = ScalableSettings::Stabilization::kPostStabilization, .refactor = refactor == 1};
+  }
 };
 
 }  // namespace cstab
