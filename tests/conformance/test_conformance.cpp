@@ -59,6 +59,15 @@ const Shortfall kShortfalls[] = {
      "the augmented Lagrangian iteration stalls at the fold at small steps (relative correction ~1e-10, or ~1e-9 "
      "with tol = 1e-9, with 50, 200 or 1000 iterations, at h = 2.5e-5 to 1e-4); at h = 1e-3 it runs through",
      0, 0, "did not converge"},
+    // n-four-bar (N = 40) passes its singular positions at t = 0.72 and 1.24: every bar horizontal,
+    // the rows lose rank N and the mechanism may leave on another branch (docs/problems.md).
+    {"n-four-bar", "baumgarte", 20,
+     "off the rows by its offset at the singular positions it leaves on another branch (error 3.9 at t = 2); "
+     "at RK4 h = 1e-3, N = 10 it stays on the parallelogram branch (tests/unit/test_n_four_bar.cpp)",
+     0, 1e-4},
+    {"n-four-bar", "none", 20,
+     "drifts off the rows, and at a singular position the drift sends it onto another branch (error 8.2 at "
+     "t = 2); over 20 s it diverges (tests/unit/test_n_four_bar.cpp)"},
 };
 
 const Shortfall* shortfall_of(const std::string& problem, const std::string& method) {
