@@ -23,6 +23,7 @@
 #include "problems/n_four_bar/n_four_bar.hpp"
 #include "problems/registry.hpp"
 #include "tests/support/test_util.hpp"
+#include "tests/support/usage_error.hpp"
 
 namespace cstab {
 namespace {
@@ -313,15 +314,7 @@ TEST(NFourBarRegression, FixedSizeMethodsRefuseNamingTheRuntimeSize) {
 
 // ---------------------------------------------------------------- bad N
 
-template <class F>
-std::string usage_error(F f) {
-  try {
-    f();
-  } catch (const UsageError& e) {
-    return e.what();
-  }
-  return "(no error)";
-}
+using testing::usage_error;
 
 TEST(NFourBarParams, BadValuesOfNNameTheParameterAndItsRange) {
   const Problem& base = find_problem("n-four-bar");

@@ -20,22 +20,14 @@
 #include "problems/pendulum/pendulum.hpp"
 #include "problems/registry.hpp"
 #include "tests/support/test_util.hpp"
+#include "tests/support/usage_error.hpp"
 
 namespace cstab {
 namespace {
 
 using Given = std::vector<std::pair<std::string, std::string>>;
 
-// The UsageError message of `f`, "(no error)" if it throws none.
-template <class F>
-std::string usage_error(F f) {
-  try {
-    f();
-  } catch (const UsageError& e) {
-    return e.what();
-  }
-  return "(no error)";
-}
+using testing::usage_error;
 
 bool contains(const std::string& s, const std::string& part) { return s.find(part) != std::string::npos; }
 
