@@ -197,8 +197,7 @@ class ScalableFormulation final : public Formulation {
         dense_[r * k + c] = jval_[i];
       }
       lu_->compute(dense_.data());
-      pivot_ratio_ = lu_->pivot_ratio();
-      return pivot_ratio_ > 0;
+      return lu_->pivot_ratio() > 0;
     }
     band_.set_zero();
     for (const auto& e : mass_) band_.at(pc[size_t(e.row)], pc[size_t(e.col)]) += e.value;
@@ -212,8 +211,7 @@ class ScalableFormulation final : public Formulation {
     // integrators pass it at moderate tolerances, and a threshold on the
     // pivot ratio (tried: 1e-10 .. 1e-15) failed runs that pass without it
     // (docs/problems.md, n-four-bar).
-    pivot_ratio_ = band_.factor() ? band_.pivot_ratio() : 0.0;
-    return pivot_ratio_ > 0;
+    return band_.factor();  // false on a zero or non-finite pivot
   }
 
   void solve() {
@@ -244,7 +242,6 @@ class ScalableFormulation final : public Formulation {
   std::vector<double> dense_;
   std::unique_ptr<linalg::Lu> lu_;
   std::string failure_;
-  double pivot_ratio_ = 1;
 };
 
 }  // namespace
