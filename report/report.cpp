@@ -21,11 +21,12 @@
 #include "io/gzip.hpp"
 #include "io/hash.hpp"
 #include "io/number.hpp"
-#include "methods/pair.hpp"
 #include "io/text.hpp"
 #include "matrix/matrix.hpp"
 #include "matrix/provenance.hpp"
 #include "matrix/results.hpp"
+#include "methods/pair.hpp"
+#include "report/scaling.hpp"
 #include "report/stress_report.hpp"
 
 #ifndef CSTAB_SOURCE_ROOT
@@ -686,10 +687,11 @@ void plan_problem_plots(PlotSet& plots, const std::string& dir, std::vector<Prob
   }
 }
 
-// The Stress section's pictures (stress_report.hpp); their names in order.
-std::vector<std::string> plan_stress_plots(PlotSet& plots, const StressSection& stress) {
+// A section's pictures (the Stress and Scaling sections); their names in order.
+std::vector<std::string> plan_section_plots(PlotSet& plots, const std::vector<StressPlot>& section_plots) {
   std::vector<std::string> names;
-  for (const StressPlot& sp : stress.plots) names.push_back(plots.add(sp.name, sp.script, sp.data, sp.vars, sp.caption));
+  for (const StressPlot& sp : section_plots)
+    names.push_back(plots.add(sp.name, sp.script, sp.data, sp.vars, sp.caption));
   return names;
 }
 
@@ -757,6 +759,8 @@ struct Page {
   const std::vector<ProblemView>& problems;
   const StressSection& stress;
   const std::vector<std::string>& stress_plots;
+  const ScalingSection& scaling;
+  const std::vector<std::string>& scaling_plots;
   const PlotSet& plots;
   const Provenance& prov;
   const std::vector<std::string>& warnings;
@@ -787,6 +791,7 @@ void html_head(std::ostream& h, const Page& pg) {
   h << "<nav>";
   for (const auto& p : pg.problems)
     h << "<a href=\"#problem-" << html_escape(p.name) << "\">" << html_escape(p.name) << "</a>";
+  if (!pg.scaling.empty) h << "<a href=\"#scaling\">scaling</a>";
   if (!pg.stress.empty) h << "<a href=\"#stress\">stress</a>";
   h << "<a href=\"#cases\">all cases</a><a href=\"#provenance\">provenance</a></nav>\n";
 }
@@ -1098,6 +1103,13 @@ void html_problems(std::ostream& h, const Page& pg) {
   }
 }
 
+// The Scaling section (scaling.hpp): its tables and pictures.
+void html_scaling(std::ostream& h, const Page& pg) {
+  if (pg.scaling.empty) return;
+  h << "<h2 id=\"scaling\">Scaling</h2>\n" << pg.scaling.html;
+  for (const auto& name : pg.scaling_plots) html_figure(h, pg.plots, name);
+}
+
 // The Stress section: its tables and pictures.
 void html_stress(std::ostream& h, const Page& pg) {
   if (pg.stress.empty) return;
@@ -1171,6 +1183,7 @@ std::string report_html(const Page& pg) {
   html_head(h, pg);
   html_overview(h, pg);
   html_problems(h, pg);
+  html_scaling(h, pg);
   html_stress(h, pg);
   html_all_cases(h, pg);
   html_tail(h, pg);
@@ -1195,7 +1208,9 @@ ReportResult build_report(const std::string& dir, const ReportOptions& opt, std:
   fs::create_directories(plots.plot_dir + "/data", ec);
   plan_problem_plots(plots, dir, problems);
   const StressSection stress = build_stress_section(folder);
-  const std::vector<std::string> stress_plots = plan_stress_plots(plots, stress);
+  const std::vector<std::string> stress_plots = plan_section_plots(plots, stress.plots);
+  const ScalingSection scaling = build_scaling_section(folder);
+  const std::vector<std::string> scaling_plots = plan_section_plots(plots, scaling.plots);
   // replot.sh, then gnuplot for what changed.
   const std::string scripts = opt.plot_scripts.empty() ? find_plot_scripts() : opt.plot_scripts;
   write_replot_script(plots, scripts);
@@ -1204,7 +1219,8 @@ ReportResult build_report(const std::string& dir, const ReportOptions& opt, std:
   for (const auto& [id, columns] : stress.series_used) result.series_used[id].insert(columns.begin(), columns.end());
   // report.html.
   const Provenance prov = parse_provenance(file_or_empty(dir + "/provenance.txt"));
-  const Page page{dir, folder.cases, problems, stress, stress_plots, plots, prov, result.warnings};
+  const Page page{dir,     folder.cases,  problems, stress, stress_plots,
+                  scaling, scaling_plots, plots,    prov,   result.warnings};
   result.html = dir + "/report.html";
   write_file_atomic(result.html, report_html(page));
   for (const auto& w : result.warnings) log << "report: warning: " << w << "\n";
