@@ -124,6 +124,18 @@ work_precision = false
 overlay = true
 optional = true
 
+# Cost against size (the report's Scaling section): fekete at N = 5 .. 40,
+# the band and the dense KKT solve (matrices/scaling.toml goes to N = 320).
+[[sweep]]
+name = "scaling"
+problems = ["fekete"]
+methods = ["projection"]
+integrators = ["rk8pd"]
+tol = [1e-6, 1e-8, 1e-10]
+problem_param.N = [5, 10, 20, 40]
+param.kkt = [0, 1]
+work_precision = false
+
 # Pesterev, Matrosov, Morozov: Adams, fixed step 1e-5, lambda = 1500, t in [0, 200].
 [[sweep]]
 name = "paper-pesterev"
