@@ -52,6 +52,11 @@ class DaeSystem {
   // calculation (IDACalcIC) is for index 1; a higher-index DAE must return
   // consistent initial_values itself (the solver checks F = 0 there).
   virtual int index() const { return 1; }
+  // The half-bandwidth of the iteration matrix dF/dy + c dF/dy' when the
+  // unknowns are ordered so that it is banded (the runtime-size models of
+  // methods/scalable.hpp): IDA then factors a band matrix, O(n) where the
+  // dense one is O(n^3). -1: dense.
+  virtual int half_bandwidth() const { return -1; }
   // r = F(t, y, y'). Returns false if F cannot be evaluated at this point.
   virtual bool residual(double t, const double* y, const double* yp, double* r) = 0;
 };

@@ -123,7 +123,9 @@ class IdaIntegrator final : public SundialsIntegrator {
     yy_.reset(wrap(y_.data()));
     ypp_.reset(wrap(yp_.data()));
     id_.reset(N_VNew_Serial(n_, ctx_));
-    if (!yy_ || !ypp_ || !id_ || !make_dense_linear_solver()) return setup_failed("out of memory");
+    const int band = dae_->half_bandwidth();
+    const bool solver = band >= 0 && band < n_ - 1 ? make_band_linear_solver(band) : make_dense_linear_solver();
+    if (!yy_ || !ypp_ || !id_ || !solver) return setup_failed("out of memory");
     mem_ = IDACreate(ctx_);
     if (!mem_) return setup_failed("out of memory");
     dae_->component_ids(N_VGetArrayPointer(id_));

@@ -5,7 +5,9 @@
 #include <cvode/cvode.h>
 #include <ida/ida.h>
 #include <nvector/nvector_serial.h>
+#include <sunlinsol/sunlinsol_band.h>
 #include <sunlinsol/sunlinsol_dense.h>
+#include <sunmatrix/sunmatrix_band.h>
 #include <sunmatrix/sunmatrix_dense.h>
 
 #include <algorithm>
@@ -140,6 +142,12 @@ N_Vector SundialsIntegrator::wrap(double* data) const { return N_VMake_Serial(n_
 bool SundialsIntegrator::make_dense_linear_solver() {
   matrix_ = SUNDenseMatrix(n_, n_, ctx_);
   linear_solver_ = matrix_ ? SUNLinSol_Dense(yy_, matrix_, ctx_) : nullptr;
+  return linear_solver_ != nullptr;
+}
+
+bool SundialsIntegrator::make_band_linear_solver(int half_bandwidth) {
+  matrix_ = SUNBandMatrix(n_, half_bandwidth, half_bandwidth, ctx_);
+  linear_solver_ = matrix_ ? SUNLinSol_Band(yy_, matrix_, ctx_) : nullptr;
   return linear_solver_ != nullptr;
 }
 

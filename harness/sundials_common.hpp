@@ -166,6 +166,8 @@ class SundialsIntegrator : public Integrator {
   // matrix_ and linear_solver_ (dense, for yy_); false if out of memory.
   N_Vector wrap(double* data) const;
   bool make_dense_linear_solver();
+  // A band matrix of half-bandwidths mu = ml = `half_bandwidth` and its LU.
+  bool make_band_linear_solver(int half_bandwidth);
   bool setup_failed(const std::string& why);  // records why; false
   bool setup_failed(int flag) { return setup_failed(sundials_flag_words(names_.package, flag)); }
   StepOutcome fail(int flag, const char* where);

@@ -153,6 +153,11 @@ struct IdaGglMethod : IdaMethod<IdaGglMethod, true> {
   static constexpr const char* kDescription =
       "DAE for --integrator ida: stabilized index-2 Gear-Gupta-Leimkuhler [q, v, lambda, mu], position and "
       "velocity constraints enforced (full rank)";
+  // Also on the runtime-size path (methods/scalable.hpp): the same DAE with
+  // its unknowns interleaved, a band matrix for IDA where the forces are local.
+  static ScalableSettings scalable_settings(const Params&) {
+    return {.stabilization = ScalableSettings::Stabilization::kGgl};
+  }
 };
 
 }  // namespace cstab

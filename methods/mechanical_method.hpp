@@ -44,7 +44,7 @@ struct MechanicalMethod {
         return {};
       } else {
         return "runs on fixed-size models only, and this problem's size is a runtime parameter (the runtime-size "
-               "path runs none, baumgarte, projection and post-stabilization: methods/scalable.hpp)";
+               "path runs none, baumgarte, projection, post-stabilization and ida-ggl: methods/scalable.hpp)";
       }
     } else {
       return "problem has no mechanical (M, Q, constraints) model";

@@ -56,7 +56,7 @@ KktOrder kkt_order(int n, int m, const std::vector<std::pair<int, int>>& pattern
   return o;
 }
 
-class ScalableFormulation final : public Formulation {
+class ScalableFormulation : public Formulation {
   using Stab = ScalableSettings::Stabilization;
 
  public:
@@ -125,6 +125,21 @@ class ScalableFormulation final : public Formulation {
     return true;
   }
 
+  // a and lambda of M a = Q + J^T lambda, J a + gamma = 0 at (t, q, v)
+  // (without stabilization terms); false if the KKT matrix is singular.
+  bool accelerations(double t, const double* q, const double* v, double* a, double* lambda) {
+    model_->forces(t, q, v, Q_.data());
+    model_->jacobian(q, jval_.data());
+    model_->gamma(q, v, gamma_.data());
+    if (!factor()) return false;
+    for (int j = 0; j < n_; ++j) b_[size_t(order_.pos_c[size_t(j)])] = Q_[size_t(j)];
+    for (int i = 0; i < m_; ++i) b_[size_t(order_.pos_r[size_t(i)])] = -gamma_[size_t(i)];
+    solve();
+    for (int j = 0; j < n_; ++j) a[j] = b_[size_t(order_.pos_c[size_t(j)])];
+    for (int i = 0; i < m_; ++i) lambda[i] = -b_[size_t(order_.pos_r[size_t(i)])];
+    return true;
+  }
+
   bool has_post_step() const override {
     return m_ > 0 && (s_.stabilization == Stab::kProjection || s_.stabilization == Stab::kPostStabilization);
   }
@@ -163,7 +178,7 @@ class ScalableFormulation final : public Formulation {
     return true;
   }
 
- private:
+ protected:
   static double max_abs(const std::vector<double>& x) {
     double r = 0;
     for (double e : x) r = std::max(r, std::abs(e));
@@ -244,9 +259,159 @@ class ScalableFormulation final : public Formulation {
   std::string failure_;
 };
 
+// The stabilized index-2 DAE of Gear, Gupta and Leimkuhler for SUNDIALS IDA
+// (as ida-ggl on the fixed path, methods/ida.hpp):
+//     q' - v - J^T mu      = 0
+//     M v' - Q - J^T lambda = 0
+//     Phi(q)               = 0
+//     J v                  = 0
+// with the unknowns interleaved in the KKT order (q_j, v_j at coordinate
+// j's place; lambda_i, mu_i at row i's) and each equation at its unknown's
+// place, so that the iteration matrix dF/dy + c dF/dy' is banded when the
+// forces are local (half_bandwidth(); IDA then factors a band matrix).
+// Starts from the model's q, v (on the rows), a and lambda from the KKT
+// system, mu = 0.
+class ScalableGglFormulation final : public ScalableFormulation, public DaeSystem {
+ public:
+  ScalableGglFormulation(const ScalableModel& model, const ScalableSettings& settings)
+      : ScalableFormulation(model, settings),
+        qv_(size_t(2 * n_)),
+        r1_(size_t(n_)),
+        r2_(size_t(n_)),
+        y0_(size_t(2 * k_)),
+        yp0_(size_t(2 * k_)) {
+    std::vector<double> a(static_cast<size_t>(n_)), lambda(static_cast<size_t>(m_));
+    model_->initial_state(qv_.data(), qv_.data() + n_);
+    start_ok_ = accelerations(0, qv_.data(), qv_.data() + n_, a.data(), lambda.data());
+    for (int j = 0; j < n_; ++j) {
+      const size_t at = size_t(2 * order_.pos_c[size_t(j)]);
+      y0_[at] = qv_[size_t(j)];
+      y0_[at + 1] = qv_[size_t(n_ + j)];
+      yp0_[at] = qv_[size_t(n_ + j)];
+      yp0_[at + 1] = a[size_t(j)];
+    }
+    for (int i = 0; i < m_; ++i) y0_[size_t(2 * order_.pos_r[size_t(i)])] = lambda[size_t(i)];
+    bandwidth_ = model_->local_forces() && !s_.dense ? ggl_bandwidth() : -1;
+  }
+
+  int dimension() const override { return 2 * k_; }
+  int dae_dimension() const override { return 2 * k_; }
+  int index() const override { return 2; }
+  int half_bandwidth() const override { return bandwidth_; }
+
+  bool rhs(double t, const double*, double*) override {
+    failure_ = "ida-ggl is a DAE formulation: it needs --integrator ida";
+    (void)t;
+    return false;
+  }
+  bool has_post_step() const override { return false; }
+
+  void initial_state(double* y) const override { std::copy(y0_.begin(), y0_.end(), y); }
+  void initial_values(double, double* y, double* yp) const override {
+    std::copy(y0_.begin(), y0_.end(), y);
+    std::copy(yp0_.begin(), yp0_.end(), yp);
+  }
+  void component_ids(double* id) const override {
+    for (int j = 0; j < n_; ++j) id[2 * order_.pos_c[size_t(j)]] = id[2 * order_.pos_c[size_t(j)] + 1] = 1.0;
+    for (int i = 0; i < m_; ++i) id[2 * order_.pos_r[size_t(i)]] = id[2 * order_.pos_r[size_t(i)] + 1] = 0.0;
+  }
+
+  void residuals(double t, const double* y, double* out) const override {
+    gather(y, observed_qv_.data());
+    ScalableFormulation::residuals(t, observed_qv_.data(), out);
+  }
+  void to_canonical(double t, const double* y, double* c) const override {
+    gather(y, observed_qv_.data());
+    ScalableFormulation::to_canonical(t, observed_qv_.data(), c);
+  }
+
+  bool residual(double t, const double* y, const double* yp, double* r) override {
+    if (!start_ok_) {
+      failure_ = "KKT matrix singular at the start: no consistent initial values";
+      return false;
+    }
+    gather(y, qv_.data());
+    const double* q = qv_.data();
+    const double* v = qv_.data() + n_;
+    model_->forces(t, q, v, Q_.data());
+    model_->jacobian(q, jval_.data());
+    model_->holonomic(q, phi_.data());
+    // r1 = J^T mu, r2 = J^T lambda; jv_ = J v.
+    std::fill(r1_.begin(), r1_.end(), 0.0);
+    std::fill(r2_.begin(), r2_.end(), 0.0);
+    std::fill(jv_.begin(), jv_.end(), 0.0);
+    for (size_t k = 0; k < pattern_.size(); ++k) {
+      const auto [row, col] = pattern_[k];
+      const size_t at = size_t(2 * order_.pos_r[size_t(row)]);
+      r2_[size_t(col)] += jval_[k] * y[at];
+      r1_[size_t(col)] += jval_[k] * y[at + 1];
+      jv_[size_t(row)] += jval_[k] * v[col];
+    }
+    for (int j = 0; j < n_; ++j) {
+      const size_t at = size_t(2 * order_.pos_c[size_t(j)]);
+      r[at] = yp[at] - y[at + 1] - r1_[size_t(j)];
+      r[at + 1] = -Q_[size_t(j)] - r2_[size_t(j)];
+    }
+    for (const auto& e : mass_)
+      r[2 * order_.pos_c[size_t(e.row)] + 1] += e.value * yp[2 * order_.pos_c[size_t(e.col)] + 1];
+    for (int i = 0; i < m_; ++i) {
+      const size_t at = size_t(2 * order_.pos_r[size_t(i)]);
+      r[at] = phi_[size_t(i)];
+      r[at + 1] = jv_[size_t(i)];
+    }
+    for (int i = 0; i < 2 * k_; ++i)
+      if (!std::isfinite(r[i])) return false;
+    return true;
+  }
+
+ private:
+  // (q, v) from the interleaved y.
+  void gather(const double* y, double* qv) const {
+    for (int j = 0; j < n_; ++j) {
+      const size_t at = size_t(2 * order_.pos_c[size_t(j)]);
+      qv[j] = y[at];
+      qv[n_ + j] = y[at + 1];
+    }
+  }
+
+  // The largest |place of an equation - place of an unknown it depends on|.
+  int ggl_bandwidth() const {
+    std::vector<std::vector<int>> cols_of_row(static_cast<size_t>(m_)), rows_of_col(static_cast<size_t>(n_));
+    for (const auto& [row, col] : pattern_) {
+      cols_of_row[size_t(row)].push_back(col);
+      rows_of_col[size_t(col)].push_back(row);
+    }
+    int w = 1;  // q_j with v_j
+    auto pc = [&](int j) { return 2 * order_.pos_c[size_t(j)]; };
+    auto pr = [&](int i) { return 2 * order_.pos_r[size_t(i)]; };
+    auto see = [&](int a, int b) { w = std::max(w, std::abs(a - b)); };
+    for (const auto& e : mass_) see(pc(e.row) + 1, pc(e.col) + 1);
+    for (int j = 0; j < n_; ++j)
+      for (int row : rows_of_col[size_t(j)]) {
+        see(pc(j), pr(row) + 1);      // J^T mu in q_j's equation
+        see(pc(j) + 1, pr(row));      // J^T lambda in v_j's equation
+        see(pr(row), pc(j));          // Phi_i in q_j
+        see(pr(row) + 1, pc(j) + 1);  // J v in v_j
+        for (int k : cols_of_row[size_t(row)]) {
+          see(pc(j), pc(k));        // d(J^T mu)/dq
+          see(pc(j) + 1, pc(k));    // d(J^T lambda)/dq
+          see(pr(row) + 1, pc(k));  // d(J v)/dq
+        }
+      }
+    return w;
+  }
+
+  std::vector<double> qv_, r1_, r2_, y0_, yp0_;
+  mutable std::vector<double> observed_qv_ = std::vector<double>(size_t(2 * n_));
+  bool start_ok_ = false;
+  int bandwidth_ = -1;
+};
+
 }  // namespace
 
 std::unique_ptr<Formulation> make_scalable_formulation(const ScalableModel& model, const ScalableSettings& settings) {
+  if (settings.stabilization == ScalableSettings::Stabilization::kGgl)
+    return std::make_unique<ScalableGglFormulation>(model, settings);
   return std::make_unique<ScalableFormulation>(model, settings);
 }
 

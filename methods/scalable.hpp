@@ -20,6 +20,10 @@
 // coordinate it touches: a chain's matrix is then banded, and the band LU
 // (linalg/band.hpp) costs O(n) per solve. `kkt = dense` solves the same
 // system with a dense LU, O(n^3): the contrast for the scaling study.
+// `kGgl` is the stabilized index-2 DAE for SUNDIALS IDA (ida-ggl), with
+// the unknowns interleaved in the same order: IDA factors a band matrix
+// where the forces are local (DaeSystem::half_bandwidth), dense with
+// `kkt = 1`.
 // Workspaces are sized at construction; rhs and post_step do not allocate.
 #pragma once
 
@@ -68,13 +72,19 @@ class ScalableModel {
   // gamma_i = v^T (d^2 Phi_i / dq^2) v.
   virtual void gamma(const double* q, const double* v, double* gamma) const = 0;
 
+  // True if Q_j depends only on the coordinates that share a mass entry or
+  // a row with j (a chain's gravity, springs along it): the DAE's iteration
+  // matrix is then banded in the KKT order. False if it couples every pair
+  // (fekete's charges): IDA then factors it dense.
+  virtual bool local_forces() const { return true; }
+
   virtual bool has_energy() const { return false; }
   virtual double energy(double /*t*/, const double* /*q*/, const double* /*v*/) const { return 0; }
 };
 
 // What a method asks of the scalable formulation.
 struct ScalableSettings {
-  enum class Stabilization { kNone, kBaumgarte, kProjection, kPostStabilization };
+  enum class Stabilization { kNone, kBaumgarte, kProjection, kPostStabilization, kGgl };
   Stabilization stabilization = Stabilization::kNone;
   double alpha = 0, beta = 0;  // Baumgarte: Phi'' + 2 alpha Phi' + beta^2 Phi = 0
   double tol = 1e-13;          // projection: stop when max |Phi| <= tol

@@ -72,6 +72,7 @@ class FeketeCartesian final : public ScalableModel {
   std::vector<std::pair<int, int>> jacobian_pattern() const override;
   void jacobian(const double* q, double* values) const override;
   void gamma(const double* q, const double* v, double* gamma) const override;
+  bool local_forces() const override { return false; }  // every pair repels
 
   // The Lyapunov function |v|^2 / 2 - sum_(i<j) log |p_i - p_j|.
   double lyapunov(const double* q, const double* v) const;

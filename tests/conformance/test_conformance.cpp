@@ -38,7 +38,7 @@ const MethodInfo& method_named(const std::string& name) { return all_methods().a
 struct Shortfall {
   const char* problem;
   const char* method;
-  double ref_error;  // the bound the pair meets at t = 2
+  double ref_error;  // the bound the pair meets at t = 2 (0: the promise's)
   const char* why;
   double residual = 0;          // > 0: the max residual it meets instead of the promise
   double energy = 0;            // > 0: the max |dE| it meets instead of the promise
@@ -65,6 +65,10 @@ const Shortfall kShortfalls[] = {
      "off the rows by its offset at the singular positions it leaves on another branch (error 3.9 at t = 2); "
      "at RK4 h = 1e-3, N = 10 it stays on the parallelogram branch (tests/unit/test_n_four_bar.cpp)",
      0, 1e-4},
+    {"n-four-bar", "ida-ggl", 0,
+     "IDA's BDF passes the singular positions at tol 1e-9 (error 1.3e-6 at t = 2) but its step there is not "
+     "error-controlled in the multipliers (algebraic components left out of the error test): |dE| 6.5e-5",
+     0, 2e-4},
     {"n-four-bar", "none", 20,
      "drifts off the rows, and at a singular position the drift sends it onto another branch (error 8.2 at "
      "t = 2); over 20 s it diverges (tests/unit/test_n_four_bar.cpp)"},
@@ -123,7 +127,7 @@ TEST_P(Conformance, StaysOnManifoldAndMatchesReference) {
   }
   if (!r.ref_state.empty() && consistent_start) {
     const double promised = promise.stabilizes ? 1e-5 : 1e-2;
-    if (known) {
+    if (known && known->ref_error > 0) {  // 0: only its residual or energy bound differs
       EXPECT_GE(r.ref_error, promised) << "meets the promise now: remove its kShortfalls row (" << known->why << ")";
       EXPECT_LT(r.ref_error, known->ref_error) << known->why;
     } else {

@@ -263,7 +263,7 @@ TEST(FeketeRegression, FixedSizeMethodsRefuse) {
   const Problem& problem = find_problem("fekete");
   for (const std::string method : {"braun-goldfarb", "ida-index1", "generalized-alpha", "rattle", "minimal"})
     EXPECT_FALSE(problem.why_not(method).empty()) << method;
-  for (const std::string method : {"none", "baumgarte", "projection", "post-stabilization"})
+  for (const std::string method : {"none", "baumgarte", "projection", "post-stabilization", "ida-ggl"})
     EXPECT_EQ(problem.why_not(method), "") << method;
 }
 
