@@ -26,6 +26,7 @@
 #include "methods/pair.hpp"
 #include "problems/fekete/fekete.hpp"
 #include "problems/registry.hpp"
+#include "tests/support/scalable_checks.hpp"
 #include "tests/support/test_util.hpp"
 #include "tests/support/usage_error.hpp"
 
@@ -66,43 +67,9 @@ double dot3(const double* a, const double* b) { return a[0] * b[0] + a[1] * b[1]
 TEST(FeketeModel, JacobianAndGammaMatchDifferencesOfTheRows) {
   for (int N : {2, 5, 20}) {
     const FeketeCartesian model(with_n(N).parameters());
-    const int n = model.coords(), m = model.rows();
     std::vector<double> q, v;
     test_state(model, q, v);
-    const auto pattern = model.jacobian_pattern();
-    std::vector<double> values(pattern.size()), gamma(static_cast<size_t>(m));
-    model.jacobian(q.data(), values.data());
-    model.gamma(q.data(), v.data(), gamma.data());
-    std::vector<double> J(static_cast<size_t>(m * n), 0.0);
-    std::vector<int> seen(static_cast<size_t>(m * n), 0);
-    for (size_t k = 0; k < pattern.size(); ++k) {
-      const auto [r, c] = pattern[k];
-      ASSERT_TRUE(r >= 0 && r < m && c >= 0 && c < n);
-      EXPECT_EQ(seen[size_t(r * n + c)]++, 0) << "entry (" << r << ", " << c << ") twice";
-      J[size_t(r * n + c)] = values[k];
-    }
-    const double h = 1e-5;
-    std::vector<double> qp = q, qm = q, fp(static_cast<size_t>(m)), fm(static_cast<size_t>(m)),
-                        f0(static_cast<size_t>(m));
-    for (int c = 0; c < n; ++c) {
-      qp[size_t(c)] += h;
-      qm[size_t(c)] -= h;
-      model.holonomic(qp.data(), fp.data());
-      model.holonomic(qm.data(), fm.data());
-      qp[size_t(c)] = qm[size_t(c)] = q[size_t(c)];
-      for (int r = 0; r < m; ++r)
-        EXPECT_NEAR(J[size_t(r * n + c)], (fp[size_t(r)] - fm[size_t(r)]) / (2 * h), 1e-8) << N << " " << r << " " << c;
-    }
-    const double s = 1e-4;
-    model.holonomic(q.data(), f0.data());
-    for (int j = 0; j < n; ++j) {
-      qp[size_t(j)] = q[size_t(j)] + s * v[size_t(j)];
-      qm[size_t(j)] = q[size_t(j)] - s * v[size_t(j)];
-    }
-    model.holonomic(qp.data(), fp.data());
-    model.holonomic(qm.data(), fm.data());
-    for (int r = 0; r < m; ++r)
-      EXPECT_NEAR(gamma[size_t(r)], (fp[size_t(r)] - 2 * f0[size_t(r)] + fm[size_t(r)]) / (s * s), 1e-5) << N;
+    testing::expect_derivatives_match_differences(model, q, v, 1e-4, 1e-8, 1e-5, "N = " + std::to_string(N));
   }
 }
 

@@ -22,6 +22,7 @@
 #include "methods/pair.hpp"
 #include "problems/n_four_bar/n_four_bar.hpp"
 #include "problems/registry.hpp"
+#include "tests/support/scalable_checks.hpp"
 #include "tests/support/test_util.hpp"
 #include "tests/support/usage_error.hpp"
 
@@ -51,45 +52,12 @@ void test_state(const NFourBarNatural& model, std::vector<double>& q, std::vecto
 // ---------------------------------------------------------------- the model
 
 TEST(NFourBarModel, JacobianAndGammaMatchDifferencesOfTheRows) {
+  // The rows are quadratic: the central difference is exact to round-off.
   for (int N : {1, 3, 8}) {
     const NFourBarNatural model(with_n(N).parameters());
-    const int n = model.coords(), m = model.rows();
     std::vector<double> q, v;
     test_state(model, q, v);
-    const auto pattern = model.jacobian_pattern();
-    std::vector<double> values(pattern.size()), gamma(static_cast<size_t>(m));
-    model.jacobian(q.data(), values.data());
-    model.gamma(q.data(), v.data(), gamma.data());
-    // Dense J from the entries; every position at most once.
-    std::vector<double> J(static_cast<size_t>(m * n), 0.0);
-    std::vector<int> seen(static_cast<size_t>(m * n), 0);
-    for (size_t k = 0; k < pattern.size(); ++k) {
-      const auto [r, c] = pattern[k];
-      ASSERT_TRUE(r >= 0 && r < m && c >= 0 && c < n);
-      EXPECT_EQ(seen[size_t(r * n + c)]++, 0) << "entry (" << r << ", " << c << ") twice";
-      J[size_t(r * n + c)] = values[k];
-    }
-    const double h = 1e-5;
-    std::vector<double> qp = q, qm = q, fp(static_cast<size_t>(m)), fm(static_cast<size_t>(m)),
-                        f0(static_cast<size_t>(m));
-    for (int c = 0; c < n; ++c) {
-      qp[size_t(c)] += h;
-      qm[size_t(c)] -= h;
-      model.holonomic(qp.data(), fp.data());
-      model.holonomic(qm.data(), fm.data());
-      qp[size_t(c)] = qm[size_t(c)] = q[size_t(c)];
-      // The rows are quadratic: the central difference is exact to round-off.
-      for (int r = 0; r < m; ++r)
-        EXPECT_NEAR(J[size_t(r * n + c)], (fp[size_t(r)] - fm[size_t(r)]) / (2 * h), 1e-8) << N << " " << r << " " << c;
-    }
-    model.holonomic(q.data(), f0.data());
-    for (int j = 0; j < n; ++j)
-      qp[size_t(j)] = q[size_t(j)] + h * v[size_t(j)], qm[size_t(j)] = q[size_t(j)] - h * v[size_t(j)];
-    model.holonomic(qp.data(), fp.data());
-    model.holonomic(qm.data(), fm.data());
-    for (int r = 0; r < m; ++r)
-      EXPECT_NEAR(gamma[size_t(r)], (fp[size_t(r)] - 2 * f0[size_t(r)] + fm[size_t(r)]) / (h * h), 1e-4)
-          << N << " " << r;
+    testing::expect_derivatives_match_differences(model, q, v, 1e-5, 1e-8, 1e-4, "N = " + std::to_string(N));
   }
 }
 
