@@ -71,6 +71,12 @@ class ProblemAdapter final : public Problem {
       f = std::make_unique<UnconstrainedAffine<std::decay_t<decltype(p_.state_space())>>>(p_.state_space());
       if (state_is_canonical(*f)) return f;
     }
+    // A runtime-size model's state is (q, v), its canonical coordinates
+    // (n-four-bar, fekete): its rows are evaluated at the canonical state.
+    if constexpr (contracts::HasScalable<P>) {
+      f = make_scalable_formulation(p_.scalable(), {});
+      if (state_is_canonical(*f)) return f;
+    }
     return nullptr;
   }
 

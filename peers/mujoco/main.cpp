@@ -3,7 +3,7 @@
 // `cstab score` (docs/cli-score.md). What is modelled and how, and the
 // parameter mapping: docs/peers-mujoco.md.
 //
-//   cstab-peer-mujoco --problem pendulum|slider-crank [--problem-param k=v[,k=v]]
+//   cstab-peer-mujoco --problem pendulum|slider-crank|n-four-bar [--problem-param k=v[,k=v]]
 //                     --integrator euler|rk4|implicit --timestep H
 //                     [--solref T,D] [--solimp D0,D1,W[,MID,POW]]
 //                     --t-end T --every DT --out FILE.csv
@@ -36,13 +36,14 @@ const char* kProgram = "cstab-peer-mujoco";
 }
 
 const char* kHelp =
-    "usage: cstab-peer-mujoco --problem pendulum|slider-crank [--problem-param k=v[,k=v...]]\n"
+    "usage: cstab-peer-mujoco --problem pendulum|slider-crank|n-four-bar [--problem-param k=v[,k=v...]]\n"
     "                         --integrator euler|rk4|implicit --timestep H\n"
     "                         [--solref T,D] [--solimp D0,D1,W[,MID,POW]]\n"
     "                         --t-end T --every DT --out FILE.csv\n"
     "  pendulum params: length (m, default 1), angle (degrees from the downward vertical, default 90)\n"
     "  slider-crank: no params (SUNDIALS idasSlCrank_dns)\n"
-    "  solref/solimp default to MuJoCo's (0.02,1) and (0.9,0.95,0.001,0.5,2), set on the loop/rod equality\n"
+    "  n-four-bar params: N (the number of four-bar loops, an integer in [1, 1000], default 40; IFToMM A02)\n"
+    "  solref/solimp default to MuJoCo's (0.02,1) and (0.9,0.95,0.001,0.5,2), set on the loop/rod equalities\n"
     "  t-end and every must be whole multiples of the timestep; rows are t = n * H\n"
     "  the first line of FILE is '# wall_seconds = S' (mj_step loop only, file writing excluded)\n";
 
@@ -132,9 +133,9 @@ Options parse_args(int argc, char** argv) {
       usage_error("unknown option '" + arg + "'");
     }
   }
-  if (o.problem.empty()) usage_error("--problem is required (pendulum or slider-crank)");
-  if (o.problem != "pendulum" && o.problem != "slider-crank")
-    usage_error("unknown problem '" + o.problem + "' (pendulum or slider-crank)");
+  if (o.problem.empty()) usage_error("--problem is required (pendulum, slider-crank or n-four-bar)");
+  if (o.problem != "pendulum" && o.problem != "slider-crank" && o.problem != "n-four-bar")
+    usage_error("unknown problem '" + o.problem + "' (pendulum, slider-crank or n-four-bar)");
   if (o.integrator.empty()) usage_error("--integrator is required (euler, rk4 or implicit)");
   if (o.integrator != "euler" && o.integrator != "rk4" && o.integrator != "implicit")
     usage_error("unknown integrator '" + o.integrator + "' (euler, rk4 or implicit)");
@@ -310,6 +311,83 @@ void slider_crank_force(const mjModel*, mjData* d) {
   d->qfrc_passive[g_dof_p] += -g_F * std::sin(d->qpos[g_qpos_p]);
 }
 
+// cstab's n-four-bar (problems/n_four_bar/n_four_bar.hpp, IFToMM A02): N
+// four-bar loops sharing their bars, 2N + 1 uniform bars (L = 1 m,
+// m = 1 kg), g = 9.81 along -y. In MuJoCo's x-y plane, which is cstab's
+// (gravity "0 -9.81 0", every hinge about z):
+//  * crank i (0..N): a body at A_i = (i L, 0), built at the initial angle
+//    theta0 = pi/2 (pi = acos(-1), as NFourBarMinimal) so its local x runs
+//    along the bar, with a hinge `A<i>` about z at its origin (ref theta0, so
+//    its qpos is the crank angle from +x);
+//  * coupler i (0..N-1): a child body of crank i at its tip B_i, local
+//    (L, 0, 0), built at -theta0 relative to the crank (horizontal), with a
+//    hinge `B<i>` about z there (ref -theta0: qpos is the angle relative to
+//    the crank); its far end, local (L, 0, 0), is joined to the tip of crank
+//    i + 1 by a `connect` equality (MuJoCo places the matching point on the
+//    crank where it is at qpos0: the crank's tip, to round-off). N loops:
+//    2N + 1 hinges, 2N independent equality rows (the z rows vanish), one
+//    degree of freedom, as in cstab;
+//  * each bar: `inertial` mass m at its midpoint, local (L/2, 0, 0),
+//    diaginertia (kAxial, m L^2/12, m L^2/12): a uniform thin bar. Every
+//    joint is a hinge about z, so only the z inertia m L^2/12 enters the
+//    mass matrix; the axial one enters no equation (MuJoCo needs it > 0);
+//  * the canonical B_i is crank i's tip from its hinge: (i L + L cos q,
+//    L sin q), velocity (-L sin q, L cos q) q'. The cranks' hinges are exact
+//    joints, so the crank rows are round-off and the coupler rows measure
+//    the soft connects' gap along the coupler;
+//  * start: cranks vertical at q' = -speed / L (B0's x velocity +speed), the
+//    couplers' relative rate +speed / L (they translate): qvel, set before
+//    the first step; the velocity constraints hold exactly there.
+struct NFourBarParams {
+  int N = 40;
+  double m = 1.0, L = 1.0, g = 9.81, speed = 1.0;
+};
+
+NFourBarParams n_four_bar_params(const Options& o) {
+  NFourBarParams p;
+  for (const auto& [k, v] : o.params) {
+    if (k == "N") {
+      const double n = parse_number(v, "--problem-param N");
+      if (!(n >= 1 && n <= 1000 && n == std::floor(n)))
+        usage_error("--problem-param N must be an integer in [1, 1000], got '" + v + "'");
+      p.N = int(n);
+    } else {
+      usage_error("n-four-bar has no parameter '" + k + "' (N)");
+    }
+  }
+  return p;
+}
+
+// The axial inertia of a thin bar (zero for a line): enters no equation.
+constexpr double kAxial = 1e-9;
+
+std::string n_four_bar_xml(const Options& o, const NFourBarParams& p) {
+  const double theta0 = std::acos(-1.0) / 2;
+  const double Iz = p.m * p.L * p.L / 12;
+  const std::string bar = "      <inertial pos=\"" + num(p.L / 2) + " 0 0\" mass=\"" + num(p.m) + "\" diaginertia=\"" +
+                          num(kAxial) + " " + num(Iz) + " " + num(Iz) + "\"/>\n";
+  std::string xml =
+      "<mujoco model=\"cstab-n-four-bar\">\n" + option_block(o, "0 " + num(-p.g) + " 0") + "  <worldbody>\n";
+  for (int i = 0; i <= p.N; ++i) {
+    const std::string s = std::to_string(i);
+    xml += "    <body name=\"crank" + s + "\" pos=\"" + num(i * p.L) + " 0 0\" euler=\"0 0 " + num(theta0) + "\">\n" +
+           bar + "      <joint name=\"A" + s + "\" type=\"hinge\" axis=\"0 0 1\" pos=\"0 0 0\" ref=\"" + num(theta0) +
+           "\"/>\n";
+    if (i < p.N)
+      xml += "      <body name=\"coupler" + s + "\" pos=\"" + num(p.L) + " 0 0\" euler=\"0 0 " + num(-theta0) +
+             "\">\n  " + bar + "        <joint name=\"B" + s + "\" type=\"hinge\" axis=\"0 0 1\" pos=\"0 0 0\" ref=\"" +
+             num(-theta0) +
+             "\"/>\n"
+             "      </body>\n";
+    xml += "    </body>\n";
+  }
+  xml += "  </worldbody>\n  <equality>\n";
+  for (int i = 0; i < p.N; ++i)
+    xml += "    <connect name=\"loop" + std::to_string(i) + "\" body1=\"coupler" + std::to_string(i) +
+           "\" body2=\"crank" + std::to_string(i + 1) + "\" anchor=\"" + num(p.L) + " 0 0\"" + solattrs(o) + "/>\n";
+  return xml + "  </equality>\n</mujoco>\n";
+}
+
 // MuJoCo's warnings and errors: kept for the one-line report, not written
 // to MUJOCO_LOG.TXT.
 std::string g_warning;
@@ -359,9 +437,16 @@ int main(int argc, char** argv) {
 
   std::string xml;
   std::vector<std::string> columns;
+  NFourBarParams four_bar;
   if (o.problem == "pendulum") {
     xml = pendulum_xml(o, pendulum_params(o));
     columns = {"x", "y", "xdot", "ydot"};
+  } else if (o.problem == "n-four-bar") {
+    four_bar = n_four_bar_params(o);
+    xml = n_four_bar_xml(o, four_bar);
+    for (const char* d : {"", "dot"})
+      for (int i = 0; i <= four_bar.N; ++i)
+        for (const char* c : {"x", "y"}) columns.push_back(c + std::string(d) + "_B" + std::to_string(i));
   } else {
     if (!o.params.empty()) usage_error("slider-crank has no parameters (got '" + o.params.front().first + "')");
     xml = slider_crank_xml(o, SliderCrankParams{});
@@ -392,6 +477,17 @@ int main(int argc, char** argv) {
       vadr.push_back(m->jnt_dofadr[id]);
     }
     mjcb_passive = nullptr;
+  } else if (o.problem == "n-four-bar") {
+    // qadr/vadr: the cranks' hinges A0..AN; the canonical B_i comes from them.
+    for (int i = 0; i <= four_bar.N; ++i) {
+      const std::string index = std::to_string(i), crank = "A" + index, coupler = "B" + index;
+      const int id = id_of(m, mjOBJ_JOINT, crank.c_str());
+      qadr.push_back(m->jnt_qposadr[id]);
+      vadr.push_back(m->jnt_dofadr[id]);
+      d->qvel[m->jnt_dofadr[id]] = -four_bar.speed / four_bar.L;
+      if (i < four_bar.N) d->qvel[m->jnt_dofadr[id_of(m, mjOBJ_JOINT, coupler.c_str())]] = four_bar.speed / four_bar.L;
+    }
+    mjcb_passive = nullptr;
   } else {
     for (const char* j : {"q", "x", "p"}) {
       const int id = id_of(m, mjOBJ_JOINT, j);
@@ -404,12 +500,28 @@ int main(int argc, char** argv) {
     g_qpos_p = qadr[2];
     mjcb_passive = slider_crank_force;
   }
-  const size_t nq = qadr.size(), width = 1 + 2 * nq;
+  const size_t width = 1 + columns.size();
 
   std::vector<double> rows;
   rows.reserve(size_t(steps / every + 2) * width);
   auto record = [&](long long n) {
     rows.push_back(double(n) * o.timestep);
+    if (o.problem == "n-four-bar") {
+      // B_i, crank i's tip, from its hinge: the expressions of
+      // NFourBarMinimal::to_canonical.
+      const double L = four_bar.L;
+      for (size_t i = 0; i < qadr.size(); ++i) {
+        const double q = d->qpos[qadr[i]];
+        rows.push_back(double(i) * L + L * std::cos(q));
+        rows.push_back(L * std::sin(q));
+      }
+      for (size_t i = 0; i < qadr.size(); ++i) {
+        const double q = d->qpos[qadr[i]], w = d->qvel[vadr[i]];
+        rows.push_back(-L * std::sin(q) * w);
+        rows.push_back(L * std::cos(q) * w);
+      }
+      return;
+    }
     for (int a : qadr) rows.push_back(d->qpos[a]);
     for (int a : vadr) rows.push_back(d->qvel[a]);
   };
@@ -427,7 +539,8 @@ int main(int argc, char** argv) {
   };
 
   // mj_makeData leaves qpos = qpos0 (the joint refs: the initial state) and
-  // qvel = 0 (the problems start at rest).
+  // qvel = 0 (the pendulum and slider crank start at rest; n-four-bar's qvel
+  // is set above).
   std::string failure;
   long long n = 0;
   const auto start = std::chrono::steady_clock::now();

@@ -2,7 +2,7 @@
 // one of Simbody's integrators at a given accuracy and constraint tolerance,
 // and written as a trajectory `cstab score` reads (docs/peers-simbody.md).
 //
-//   cstab-peer-simbody --problem pendulum|slider-crank|bricard|andrews|car-axis
+//   cstab-peer-simbody --problem pendulum|slider-crank|bricard|andrews|car-axis|n-four-bar
 //       [--problem-param k=v[,k=v]] [--closure redundant|independent]
 //       --integrator rk3|rkmerson|rkfeldberg|verlet|euler|cpodes --accuracy A
 //       [--constraint-tolerance C] [--t-end T] [--every DT] --out FILE.csv
@@ -10,9 +10,9 @@
 // The program is deliberately independent of cstab's code: it restates the
 // problems' parameters (problems/pendulum/pendulum.hpp,
 // problems/slider_crank/slider_crank.hpp, problems/bricard/bricard.hpp,
-// problems/andrews/andrews.hpp, problems/car_axis/car_axis.hpp) the way an
-// outside user would, and tests/peers/test_simbody.cpp checks that the two
-// agree.
+// problems/andrews/andrews.hpp, problems/car_axis/car_axis.hpp,
+// problems/n_four_bar/n_four_bar.hpp) the way an outside user would, and
+// tests/peers/test_simbody.cpp checks that the two agree.
 //
 // Exit codes: 0 done; 1 Simbody failed during integration (the rows up to the
 // failure are written, the error printed); 2 bad input (one line, nothing run).
@@ -64,7 +64,8 @@ struct Options {
 };
 
 const char* kUsage =
-    "usage: cstab-peer-simbody --problem pendulum|slider-crank|bricard|andrews|car-axis [--problem-param k=v[,k=v]] "
+    "usage: cstab-peer-simbody --problem pendulum|slider-crank|bricard|andrews|car-axis|n-four-bar "
+    "[--problem-param k=v[,k=v] (pendulum: length, angle; n-four-bar: N)] "
     "--integrator rk3|rkmerson|rkfeldberg|verlet|euler|cpodes [--accuracy A (1e-3)] "
     "[--closure redundant|independent (bricard; redundant)] "
     "[--constraint-tolerance C (0.1 A)] [--t-end T (10)] [--every DT (0.01)] --out FILE.csv";
@@ -111,10 +112,12 @@ Options parse(int argc, char** argv) {
     }
   }
   (void)have_accuracy;
-  if (o.problem.empty()) bad("--problem is required (pendulum, slider-crank, bricard, andrews or car-axis)");
+  if (o.problem.empty())
+    bad("--problem is required (pendulum, slider-crank, bricard, andrews, car-axis or n-four-bar)");
   if (o.problem != "pendulum" && o.problem != "slider-crank" && o.problem != "bricard" && o.problem != "andrews" &&
-      o.problem != "car-axis")
-    bad("--problem: '" + o.problem + "' is not modelled (pendulum, slider-crank, bricard, andrews, car-axis)");
+      o.problem != "car-axis" && o.problem != "n-four-bar")
+    bad("--problem: '" + o.problem +
+        "' is not modelled (pendulum, slider-crank, bricard, andrews, car-axis, n-four-bar)");
   if (!o.closure.empty() && o.problem != "bricard") bad("--closure: only bricard has a choice of loop closure");
   if (o.closure.empty() && o.problem == "bricard") o.closure = "redundant";
   if (o.problem == "bricard" && o.closure != "redundant" && o.closure != "independent")
@@ -578,6 +581,90 @@ struct CarAxisModel : Model {
   }
 };
 
+// cstab's `n-four-bar` (IFToMM A02, problems/n_four_bar/n_four_bar.hpp): N
+// four-bar loops sharing their bars, 2N + 1 uniform bars of length L and mass
+// m, gravity g along -y. Cranks A_i B_i (i = 0..N) turn about the ground
+// points A_i = (i L, 0); couplers B_i B_(i+1) (i = 0..N-1) join their tips.
+// Starts with every crank vertical (B_i = (i L, L)) and B0 moving at `speed`
+// along +x: every crank turns at -speed / L and the couplers translate.
+//
+// In Simbody: crank i is a MobilizedBody::Pin from Ground at A_i whose body
+// frame has its origin at A_i and x along the crank, so its q is the crank's
+// angle from +x (pi/2 at the start, u = -speed / L); coupler i is a Pin on
+// crank i's tip (L, 0, 0), its body frame's origin at B_i and x along the
+// coupler, its q the coupler's angle relative to crank i (-pi/2 at the
+// start, u = +speed / L, so that it translates). Loop i is closed by a
+// Constraint::PointOnLine holding coupler i's far end (L, 0, 0) on the z
+// line through crank i+1's tip: two rows, the planar coincidence (as for the
+// slider crank; a Constraint::Ball would add a z row that is identically
+// zero, since every Pin turns about z, i.e. a redundant row everywhere).
+// 2N + 1 mobilities, 2N closure rows, one degree of freedom; the rows are
+// independent except at the singular positions, where every bar is
+// horizontal and each loop's x row loses rank (docs/peers-simbody.md).
+//
+// Every Pin turns about z, so the motion is planar by construction: no body
+// can leave the plane z = 0 or turn about x or y, and only the z inertia
+// enters the dynamics. Bars are uniform thin rods: centre of mass at
+// (L/2, 0, 0), m L^2/12 about the two transverse axes through it and 0 about
+// the bar's own axis, i.e. (0, m L^2/3, m L^2/3) about the bar's start (the
+// body origin), as Bricard's rods. Gravity's potential is m g y_centre per
+// bar, zero at y = 0, cstab's m g / 2 (y at each bar end) summed.
+struct NFourBarModel : Model {
+  int N = 40;  // as NFourBarParameters
+  double m = 1.0, L = 1.0, g = 9.81, speed = 1.0;
+  std::vector<MobilizedBody::Pin> cranks, couplers;
+
+  explicit NFourBarModel(const std::map<std::string, std::string>& params) {
+    for (const auto& [k, v] : params) {
+      if (k != "N") bad("--problem-param: n-four-bar has no parameter '" + k + "' (N)");
+      const double n = number("--problem-param N", v);
+      if (!(n >= 1 && n <= 1000) || n != std::floor(n)) bad("--problem-param N: must be an integer in [1, 1000]");
+      N = int(n);
+    }
+    Force::UniformGravity(forces, matter, Vec3(0, -g, 0));
+    const Body::Rigid bar(MassProperties(m, Vec3(L / 2, 0, 0), Inertia(0, m * L * L / 3, m * L * L / 3)));
+    for (int i = 0; i <= N; ++i)
+      cranks.push_back(MobilizedBody::Pin(matter.Ground(), Transform(Vec3(i * L, 0, 0)), bar, Transform()));
+    for (int i = 0; i < N; ++i) {
+      couplers.push_back(MobilizedBody::Pin(cranks[i], Transform(Vec3(L, 0, 0)), bar, Transform()));
+      Constraint::PointOnLine(cranks[i + 1], UnitVec3(ZAxis), Vec3(L, 0, 0), couplers[i], Vec3(L, 0, 0));
+    }
+  }
+  std::vector<std::string> columns() const override {
+    std::vector<std::string> c;
+    for (const char* suffix : {"", "dot"})
+      for (int i = 0; i <= N; ++i)
+        for (const char* axis : {"x", "y"}) c.push_back(axis + std::string(suffix) + "_B" + std::to_string(i));
+    return c;
+  }
+  void initial_state(State& s) const override {
+    const double half_pi = std::acos(-1.0) / 2;
+    for (const auto& crank : cranks) {
+      crank.setOneQ(s, 0, half_pi);
+      crank.setOneU(s, 0, -speed / L);
+    }
+    for (const auto& coupler : couplers) {
+      coupler.setOneQ(s, 0, -half_pi);
+      coupler.setOneU(s, 0, speed / L);
+    }
+  }
+  void canonical(const State& s, double* c) const override {
+    system.realize(s, Stage::Velocity);
+    const int n = 2 * (N + 1);
+    for (int i = 0; i <= N; ++i) {
+      // B0 is crank 0's tip; B_i (i >= 1) coupler i-1's far end, which the
+      // closure holds on crank i's tip to within the constraint tolerance
+      // (with the cranks' tips instead, the rows cstab scores would only see
+      // whether the cranks stay parallel, which they do by symmetry to
+      // round-off, and not Simbody's closure error).
+      const MobilizedBody& body = i == 0 ? cranks[0] : couplers[i - 1];
+      const Vec3 p = body.findStationLocationInGround(s, Vec3(L, 0, 0));
+      const Vec3 v = body.findStationVelocityInGround(s, Vec3(L, 0, 0));
+      c[2 * i] = p[0], c[2 * i + 1] = p[1], c[n + 2 * i] = v[0], c[n + 2 * i + 1] = v[1];
+    }
+  }
+};
+
 std::unique_ptr<Integrator> make_integrator(const std::string& name, const System& system) {
   if (name == "rk3") return std::make_unique<RungeKutta3Integrator>(system);
   if (name == "rkmerson") return std::make_unique<RungeKuttaMersonIntegrator>(system);
@@ -612,8 +699,10 @@ int main(int argc, char** argv) {
       model = std::make_unique<BricardModel>(o.params, o.closure == "redundant");
     else if (o.problem == "andrews")
       model = std::make_unique<AndrewsModel>(o.params);
-    else
+    else if (o.problem == "car-axis")
       model = std::make_unique<CarAxisModel>(o.params);
+    else
+      model = std::make_unique<NFourBarModel>(o.params);
     out.open(o.out);
     if (!out) bad("--out: cannot write '" + o.out + "'");
   } catch (const BadInput& e) {

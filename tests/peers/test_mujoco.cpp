@@ -18,6 +18,7 @@
 #include <string>
 #include <vector>
 
+#include "problems/n_four_bar/n_four_bar.hpp"
 #include "problems/pendulum/pendulum.hpp"
 
 namespace {
@@ -120,6 +121,122 @@ class PeerMujoco : public ::testing::Test {
   }
 };
 
+// n-four-bar (`cstab score` has no observer for its runtime-size model, so
+// these compare with NFourBar's own initial state, energy, rows and
+// reference). The trajectory: its header and rows, the values of each row.
+struct Table {
+  std::vector<std::string> header;
+  std::vector<std::vector<double>> rows;
+};
+
+Table read_table(const fs::path& csv) {
+  Table t;
+  std::ifstream in(csv);
+  std::string line;
+  while (std::getline(in, line)) {
+    if (line.empty() || line[0] == '#') continue;
+    if (t.header.empty()) {
+      t.header = split(line);
+      continue;
+    }
+    std::vector<double> v;
+    for (const auto& c : split(line)) v.push_back(std::stod(c));
+    t.rows.push_back(v);
+  }
+  return t;
+}
+
+double max_abs_difference(const double* a, const double* b, size_t n) {
+  double d = 0;
+  for (size_t i = 0; i < n; ++i) d = std::max(d, std::abs(a[i] - b[i]));
+  return d;
+}
+
+// The largest |row| of the natural formulation's 2N + 1 bar constraints
+// (|B_i - A_i|^2 - L^2, |B_(i+1) - B_i|^2 - L^2) at a canonical state.
+double max_bar_residual(const cstab::NFourBar& problem, const double* canonical) {
+  std::vector<double> phi(size_t(problem.scalable().rows()));
+  problem.scalable().holonomic(canonical, phi.data());
+  double r = 0;
+  for (double x : phi) r = std::max(r, std::abs(x));
+  return r;
+}
+
+TEST_F(PeerMujoco, NFourBarStartIsCstabsToRoundOff) {
+  SKIP_WITHOUT_PEER();
+  for (const int N : {1, 3, 40, 200}) {
+    SCOPED_TRACE("N = " + std::to_string(N));
+    cstab::NFourBarParameters p;
+    p.N = N;
+    const cstab::NFourBar problem(p);
+    const size_t n = size_t(problem.canonical_size());
+    // N = 40 is the default: no parameter.
+    const std::string param = N == 40 ? "" : " --problem-param N=" + std::to_string(N);
+    const Table t = read_table(simulate(
+        "start", "--problem n-four-bar" + param + " --integrator rk4 --timestep 1e-3 --t-end 0.01 --every 0.01"));
+    // The header is cstab's coordinates, in cstab's order.
+    std::vector<std::string> expected = {"t"};
+    for (const auto& c : problem.info().coordinates) expected.push_back(c);
+    EXPECT_EQ(t.header, expected);
+    ASSERT_EQ(t.rows.size(), 2u);
+    ASSERT_EQ(t.rows[0].size(), n + 1);
+    EXPECT_EQ(t.rows[0][0], 0.0);
+    const double* row = t.rows[0].data() + 1;
+    std::vector<double> start(n);
+    problem.scalable().initial_state(start.data(), start.data() + n / 2);
+    // B_i = (i L + L cos(pi/2), L sin(pi/2)): cos(pi/2) = 6.1e-17.
+    const double deviation = max_abs_difference(row, start.data(), n);
+    EXPECT_LE(deviation, 4e-16);
+    EXPECT_LE(max_bar_residual(problem, row), 4e-16);
+    const double e0 = problem.energy(0, start.data()), e = problem.energy(0, row);
+    EXPECT_NEAR(e, e0, 4e-16 * std::abs(e0)) << "E0 = " << e0;
+    std::printf("n-four-bar N = %d: initial state deviation %.3g, residual %.3g, energy %.17g vs %.17g (diff %.3g)\n",
+                N, deviation, max_bar_residual(problem, row), e, e0, e - e0);
+  }
+}
+
+// The largest |error| against cstab's reference (every canonical
+// coordinate, velocities included) of an N = 40 run to t = 0.5.
+double n_four_bar_error(const Table& t, double t_end) {
+  const cstab::NFourBar problem;
+  std::vector<double> ref(size_t(problem.canonical_size()));
+  if (t.rows.empty() || t.rows.back()[0] != t_end || !problem.reference(t_end, ref.data())) return NAN;
+  return max_abs_difference(t.rows.back().data() + 1, ref.data(), ref.size());
+}
+
+// A short N = 40 run (RK4, to t = 0.5) against cstab's reference: the error
+// is the soft connects' (docs/peers-mujoco.md), so it falls as solref's time
+// constant does. Measured: 3.61e-3, 9.77e-5, 6.46e-6 (error, every
+// canonical coordinate at t = 0.5); |E - E0| 2.39e-3, 8.25e-5, 5.82e-6 J of
+// E0 = 620.34 J. The bounds are those with a factor ~1.5-3 of margin. With
+// every bar's central inertia 5 % too large the runs measured 6.8e-3,
+// 6.2e-3, 6.1e-3 and |E - E0| 0.51 J: the mass properties are checked.
+TEST_F(PeerMujoco, NFourBarShortRunConvergesToTheReference) {
+  SKIP_WITHOUT_PEER();
+  struct Case {
+    std::string timestep, solref;
+    double max_error, max_energy_drift;
+  };
+  const cstab::NFourBar problem;
+  double previous = INFINITY;
+  for (const Case& c : {Case{"1e-3", "0.02,1", 6e-3, 5e-3}, Case{"1e-3", "0.002,1", 2e-4, 2e-4},
+                        Case{"1e-4", "0.0005,1", 2e-5, 1.5e-5}}) {
+    SCOPED_TRACE("timestep " + c.timestep + ", solref " + c.solref);
+    const Table t = read_table(simulate("short", "--problem n-four-bar --integrator rk4 --timestep " + c.timestep +
+                                                     " --t-end 0.5 --every 0.01 --solref " + c.solref));
+    ASSERT_EQ(t.rows.size(), 51u);
+    const double error = n_four_bar_error(t, 0.5);
+    const double drift =
+        std::abs(problem.energy(0, t.rows.back().data() + 1) - problem.energy(0, t.rows[0].data() + 1));
+    std::printf("n-four-bar N = 40, rk4, h = %s, solref %s: error at t = 0.5 %.3g, |E - E0| %.3g\n", c.timestep.c_str(),
+                c.solref.c_str(), error, drift);
+    EXPECT_LE(error, c.max_error);
+    EXPECT_LE(drift, c.max_energy_drift);
+    EXPECT_LT(error, previous / 10);
+    previous = error;
+  }
+}
+
 TEST_F(PeerMujoco, InitialStateIsCstabsToRoundOff) {
   SKIP_WITHOUT_PEER();
   struct Case {
@@ -211,14 +328,16 @@ TEST_F(PeerMujoco, BadInputExits2WithOneLine) {
   const std::string ok = " --integrator rk4 --timestep 1e-3 --t-end 1 --every 0.01 --out " + (dir / "b.csv").string();
   for (const std::string& args : std::vector<std::string>{
            "--problem wheel" + ok, "--problem pendulum --integrator rk5 --timestep 1e-3 --t-end 1 --every 0.01 --out x",
-        "--problem pendulum --problem-param mass=2" + ok, "--problem slider-crank --problem-param length=2" + ok,
-        "--problem pendulum --problem-param length=-1" + ok,
-        "--problem pendulum --integrator rk4 --timestep 0 --t-end 1 --every 0.01 --out x",
-        "--problem pendulum --integrator rk4 --timestep 3e-3 --t-end 1 --every 0.01 --out x",
-        "--problem pendulum --integrator rk4 --timestep 1e-3 --t-end 1 --every 0.01",
-        "--problem pendulum --solref 0.02" + ok, "--problem pendulum --solref 0.02,nan" + ok,
-        "--problem pendulum --solimp 2,0.95,0.001" + ok, "--problem pendulum --bogus 1" + ok,
-        "--problem pendulum --integrator rk4 --timestep 1e-3 --t-end 1 --every 0.01 --out /nonexistent/dir/x.csv"}) {
+           "--problem pendulum --problem-param mass=2" + ok, "--problem slider-crank --problem-param length=2" + ok,
+           "--problem pendulum --problem-param length=-1" + ok, "--problem n-four-bar --problem-param N=0" + ok,
+           "--problem n-four-bar --problem-param N=1001" + ok, "--problem n-four-bar --problem-param N=2.5" + ok,
+           "--problem n-four-bar --problem-param N=many" + ok, "--problem n-four-bar --problem-param M=3" + ok,
+           "--problem pendulum --integrator rk4 --timestep 0 --t-end 1 --every 0.01 --out x",
+           "--problem pendulum --integrator rk4 --timestep 3e-3 --t-end 1 --every 0.01 --out x",
+           "--problem pendulum --integrator rk4 --timestep 1e-3 --t-end 1 --every 0.01",
+           "--problem pendulum --solref 0.02" + ok, "--problem pendulum --solref 0.02,nan" + ok,
+           "--problem pendulum --solimp 2,0.95,0.001" + ok, "--problem pendulum --bogus 1" + ok,
+           "--problem pendulum --integrator rk4 --timestep 1e-3 --t-end 1 --every 0.01 --out /nonexistent/dir/x.csv"}) {
     SCOPED_TRACE(args);
     const auto o = run(std::string(kPeer) + " " + args);
     EXPECT_EQ(o.code, 2) << o.out;

@@ -231,6 +231,28 @@ INSTANTIATE_TEST_SUITE_P(All, StepLoop, ::testing::ValuesIn(all_cases()), case_n
 
 // The whole harness loop, observation included (no series file): the
 // allocation count of a run must not depend on how many steps it takes.
+// The runtime-size path at the largest size (N = 320), where the
+// registered problems above run at their default N: no allocation per step
+// either, for every method on it (IDA's band matrix for ida-ggl).
+TEST(RuntimeSize, NoAllocationPerStepAtN320) {
+  for (const std::string name : {"n-four-bar", "fekete"}) {
+    const auto problem = problem_variant(find_problem(name), {{"N", "320"}});
+    for (const std::string method : {"none", "baumgarte", "projection", "post-stabilization", "ida-ggl"}) {
+      const bool dae = method == "ida-ggl";
+      if (dae && name == "fekete") continue;  // dense there: the registered N covers it
+      auto form = problem->make(method, "", Params::resolve(problem->method_params(method, ""), {}, method));
+      const StepSettings s = dae ? StepSettings{0, 1e-6, 1e-6} : StepSettings{1e-3, 0, 0};
+      const StepAllocations a = count_step_allocations(*form, dae ? "ida" : "rk4", s, 5, 20);
+      ASSERT_FALSE(a.warmup_failed) << name << " " << method << ": " << a.failure;
+      ASSERT_EQ(a.taken, 20) << name << " " << method << ": " << a.failure;
+      EXPECT_EQ(a.allocations, 0) << name << " " << method;
+      if (AllocationWindow::counts_malloc_family()) {
+        EXPECT_EQ(a.library_allocations, 0) << name << " " << method;
+      }
+    }
+  }
+}
+
 class Harness : public ::testing::TestWithParam<Case> {};
 
 TEST_P(Harness, AllocationsIndependentOfStepCount) {

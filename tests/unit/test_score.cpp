@@ -116,6 +116,10 @@ TEST(Score, ReproducesTheSummaryOfTheRunThatWroteTheTrajectory) {
   expect_score_reproduces_run({"wheel", "pesterev", "state-space", "rk4", 1e-3, 1, 0});
   // A perturbed start: initial residual and recovery time.
   expect_score_reproduces_run({"car-axis", "baumgarte", "", "rk4", 1e-3, 1, 1e-3});
+  // Runtime-size models (their state is the canonical one): n-four-bar
+  // through its first singular position, fekete to its reference time.
+  expect_score_reproduces_run({"n-four-bar", "post-stabilization", "", "rk4", 1e-2, 2, 0});
+  expect_score_reproduces_run({"fekete", "projection", "", "rk4", 1e-2, 20, 0});
 }
 
 // theta(t) = 0.3 sin(2 t) on a circle of radius L + d: the residual
