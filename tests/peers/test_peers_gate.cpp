@@ -48,11 +48,12 @@ TEST(PeersGate, EveryEngineAtItsDefaultsRunsAsACaseAndPassesTheCommittedGate) {
   ASSERT_EQ(m.code, 0) << m.out;
   // 4 Simbody integrators and MuJoCo's Euler on pendulum and slider crank,
   // SUNDIALS' example on the slider crank, 3 Simbody integrators on bricard
-  // and on andrews, 4 on the car axis.
-  EXPECT_TRUE(contains(m.out, "21 cases: 21 run, 0 cached")) << m.out;
-  EXPECT_TRUE(contains(m.out, "21 ok")) << m.out;
+  // and on andrews, 4 on the car axis; on n-four-bar (N = 10) 3 Simbody
+  // integrators and MuJoCo's Euler.
+  EXPECT_TRUE(contains(m.out, "25 cases: 25 run, 0 cached")) << m.out;
+  EXPECT_TRUE(contains(m.out, "25 ok")) << m.out;
   const cstab::CsvTable s = cstab::read_csv((dir / "out" / "summary.csv").string());
-  ASSERT_EQ(s.rows.size(), 21u);
+  ASSERT_EQ(s.rows.size(), 25u);
   for (size_t i = 0; i < s.rows.size(); ++i) {
     EXPECT_EQ(s.get(i, "integrator"), "external") << i;
     EXPECT_EQ(s.get(i, "status"), "ok") << s.get(i, "method");
