@@ -4,6 +4,8 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <string>
 #include <vector>
 
@@ -56,6 +58,51 @@ inline void expect_derivatives_match_differences(const ScalableModel& model, con
   for (int r = 0; r < m; ++r)
     EXPECT_NEAR(gamma[size_t(r)], (fp[size_t(r)] - 2 * f0[size_t(r)] + fm[size_t(r)]) / (s * s), tol_gamma)
         << what << " " << r;
+}
+
+}  // namespace cstab::testing
+
+namespace cstab::testing {
+
+// How a runtime-size formulation's index-1 ODE y' = f(y) couples its states:
+// the Jacobian by central differences at y (step 1e-6 times max(1, |y_j|)),
+// an entry counted when it exceeds 1e-9 of the largest. `filled`: the share
+// of nonzero entries in the acceleration rows (the lower half); `bandwidth`:
+// the largest |i - j| of a nonzero entry anywhere, which a band linear
+// solver would need as its half-bandwidth (2n - 1 means dense).
+struct OdeCoupling {
+  double filled = 0;
+  int bandwidth = 0;
+};
+inline OdeCoupling ode_coupling(const ScalableModel& model, const ScalableSettings& settings,
+                                const std::vector<double>& y) {
+  const auto f = make_scalable_formulation(model, settings);
+  const int N = static_cast<int>(y.size()), n = N / 2;
+  std::vector<double> J(static_cast<size_t>(N) * static_cast<size_t>(N)), yp = y, ym = y, fp(static_cast<size_t>(N)),
+                                                                          fm(static_cast<size_t>(N));
+  double largest = 0;
+  for (int j = 0; j < N; ++j) {
+    const double h = 1e-6 * std::max(1.0, std::abs(y[size_t(j)]));
+    yp[size_t(j)] += h;
+    ym[size_t(j)] -= h;
+    EXPECT_TRUE(f->rhs(0, yp.data(), fp.data()) && f->rhs(0, ym.data(), fm.data()));
+    yp[size_t(j)] = ym[size_t(j)] = y[size_t(j)];
+    for (int i = 0; i < N; ++i) {
+      const double d = (fp[size_t(i)] - fm[size_t(i)]) / (2 * h);
+      J[size_t(i) * size_t(N) + size_t(j)] = d;
+      largest = std::max(largest, std::abs(d));
+    }
+  }
+  OdeCoupling out;
+  long nonzero = 0;
+  for (int i = 0; i < N; ++i)
+    for (int j = 0; j < N; ++j) {
+      if (std::abs(J[size_t(i) * size_t(N) + size_t(j)]) <= 1e-9 * largest) continue;
+      out.bandwidth = std::max(out.bandwidth, std::abs(i - j));
+      if (i >= n) ++nonzero;
+    }
+  out.filled = static_cast<double>(nonzero) / (static_cast<double>(n) * N);
+  return out;
 }
 
 }  // namespace cstab::testing

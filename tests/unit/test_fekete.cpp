@@ -18,6 +18,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <map>
 #include <string>
 #include <vector>
@@ -153,6 +154,26 @@ TEST(FeketeModel, KktAccelerationsEqualTheClosedFormPerParticle) {
   }
   EXPECT_LE(scalable_bandwidth(model), 3);
   EXPECT_EQ(scalable_bandwidth(with_n(400).scalable()), scalable_bandwidth(model));
+}
+
+// Why cvode-bdf keeps a dense linear solver here: every pair of particles
+// interacts, so each acceleration depends on every position (half the
+// columns) and on its own velocity; a band would need the whole width.
+TEST(FeketeModel, TheIndex1OdeJacobianIsDenseSoCvodeGetsNoBand) {
+  for (int N : {5, 20}) {
+    const FeketeCartesian model(with_n(N).parameters());
+    std::vector<double> q, v;
+    test_state(model, q, v);
+    std::vector<double> y(q);
+    y.insert(y.end(), v.begin(), v.end());
+    const int n = model.coords();
+    const auto c = testing::ode_coupling(model, {}, y);
+    EXPECT_EQ(c.bandwidth, 2 * n - 1) << N;
+    // Every position column and the three own-velocity columns: (n + 3) / 2n.
+    EXPECT_NEAR(c.filled, (n + 3.0) / (2.0 * n), 1e-12) << N;
+    std::printf("fekete N = %d (%d states): %.1f %% of the acceleration rows nonzero, bandwidth %d\n", N, 2 * n,
+                100 * c.filled, c.bandwidth);
+  }
 }
 
 // ---------------------------------------------------------------- the reference
