@@ -299,9 +299,8 @@ class ScalableGglFormulation final : public ScalableFormulation, public DaeSyste
   int index() const override { return 2; }
   int half_bandwidth() const override { return bandwidth_; }
 
-  bool rhs(double t, const double*, double*) override {
+  bool rhs(double, const double*, double*) override {
     failure_ = "ida-ggl is a DAE formulation: it needs --integrator ida";
-    (void)t;
     return false;
   }
   bool has_post_step() const override { return false; }
