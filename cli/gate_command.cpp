@@ -42,76 +42,61 @@ void declare_gate(Args& a) {
              format_short(d.recovery));
 }
 
-int cmd_gate(const Args& args) {
-  const std::string dir = args.require("DIR");
-  if (!std::filesystem::is_directory(dir)) throw UsageError(dir + ": no such results folder");
-  GateFactors factors;
-  factors.value = args.number("--factor");
-  factors.time_ratio = args.number("--time-factor");
-  factors.recovery = args.number("--recovery-factor");
+namespace {
 
-  if (args.has("--init")) {
-    if (args.has("--update") || args.has("--thresholds") || args.has("--csv"))
-      throw UsageError("--init FILE: writes a new file; not with --update, --thresholds or --csv");
-    const std::string path = args.get("--init");
-    if (std::filesystem::exists(path)) throw UsageError("--init " + path + ": exists (use --update to re-baseline it)");
-    const ThresholdsFile file = initial_thresholds(dir, factors, path);
-    try {
-      write_file_atomic(path, thresholds_text(file));
-    } catch (const std::exception& e) {
-      throw UsageError("--init " + path + ": " + e.what());
-    }
-    std::cout << "gate: wrote " << path << " with " << file.rows.size() << " cases from " << dir
-              << " (factor " << format_short(factors.value) << ")\n";
-    return 0;
+// Writes the thresholds file, or says which file could not be written.
+void write_thresholds(const std::string& option, const std::string& path, const ThresholdsFile& file) {
+  try {
+    write_file_atomic(path, thresholds_text(file));
+  } catch (const std::exception& e) {
+    throw UsageError(option + " " + path + ": cannot write: " + e.what());
   }
+}
 
-  const std::string path = args.has("--thresholds") ? args.get("--thresholds") : kDefaultThresholds;
-  ThresholdsFile file = read_thresholds_file(path);
+int gate_init(const Args& args, const std::string& dir, const GateFactors& factors) {
+  if (args.has("--update") || args.has("--thresholds") || args.has("--csv"))
+    throw UsageError("--init FILE: writes a new file; not with --update, --thresholds or --csv");
+  const std::string path = args.get("--init");
+  if (std::filesystem::exists(path)) throw UsageError("--init " + path + ": exists (use --update to re-baseline it)");
+  const ThresholdsFile file = initial_thresholds(dir, factors, path);
+  write_thresholds("--init", path, file);
+  std::cout << "gate: wrote " << path << " with " << file.rows.size() << " cases from " << dir << " (factor "
+            << format_short(factors.value) << ")\n";
+  return 0;
+}
 
-  // A folder a matrix is still writing is not re-baselined from.
-  std::unique_ptr<FolderLock> lock;
-  if ((args.has("--add-missing") || args.has("--update")) && std::filesystem::is_directory(dir + "/cases"))
-    lock = std::make_unique<FolderLock>(dir, "cstab gate");
-  if (args.has("--add-missing")) {
-    if (args.has("--update") || args.has("--csv") || args.has("--strict"))
-      throw UsageError("--add-missing: writes the thresholds file; not with --update, --csv or --strict");
-    const auto added = add_missing_thresholds(file, dir, factors);
-    for (const auto& label : added) std::cout << "added: " << label << "\n";
-    if (!added.empty()) {
-      try {
-        write_file_atomic(path, thresholds_text(file));
-      } catch (const std::exception& e) {
-        throw UsageError("--thresholds " + path + ": cannot write: " + e.what());
-      }
-    }
-    std::cout << "gate: " << added.size() << " rows added to " << path << " (factor " << format_short(factors.value)
-              << ")\n";
-    return 0;
-  }
+int gate_add_missing(const Args& args, const std::string& dir, const GateFactors& factors, const std::string& path,
+                     ThresholdsFile& file) {
+  if (args.has("--update") || args.has("--csv") || args.has("--strict"))
+    throw UsageError("--add-missing: writes the thresholds file; not with --update, --csv or --strict");
+  const auto added = add_missing_thresholds(file, dir, factors);
+  for (const auto& label : added) std::cout << "added: " << label << "\n";
+  if (!added.empty()) write_thresholds("--thresholds", path, file);
+  std::cout << "gate: " << added.size() << " rows added to " << path << " (factor " << format_short(factors.value)
+            << ")\n";
+  return 0;
+}
 
-  if (args.has("--update")) {
-    if (args.has("--csv")) throw UsageError("--csv: not with --update");
-    if (args.has("--strict")) throw UsageError("--strict: not with --update");
-    std::vector<std::string> notes;
-    const auto changes = update_thresholds(file, dir, factors, notes);
-    for (const auto& n : notes) std::cout << "note: " << n << "\n";
-    for (const auto& c : changes)
-      std::cout << c.case_label << "  " << c.column << ": " << (c.old_value.empty() ? "(empty)" : c.old_value)
-                << " -> " << c.new_value << "\n";
-    if (!changes.empty()) {
-      try {
-        write_file_atomic(path, thresholds_text(file));
-      } catch (const std::exception& e) {
-        throw UsageError("--thresholds " + path + ": cannot write: " + e.what());
-      }
-    }
-    std::cout << "gate: " << changes.size() << " thresholds changed in " << path << " (factor "
-              << format_short(factors.value) << ", time factor " << format_short(factors.time_ratio)
-              << ", recovery factor " << format_short(factors.recovery) << ")\n";
-    return 0;
-  }
+int gate_update(const Args& args, const std::string& dir, const GateFactors& factors, const std::string& path,
+                ThresholdsFile& file) {
+  if (args.has("--csv")) throw UsageError("--csv: not with --update");
+  if (args.has("--strict")) throw UsageError("--strict: not with --update");
+  std::vector<std::string> notes;
+  const auto changes = update_thresholds(file, dir, factors, notes);
+  for (const auto& n : notes) std::cout << "note: " << n << "\n";
+  for (const auto& c : changes)
+    std::cout << c.case_label << "  " << c.column << ": " << (c.old_value.empty() ? "(empty)" : c.old_value) << " -> "
+              << c.new_value << "\n";
+  if (!changes.empty()) write_thresholds("--thresholds", path, file);
+  std::cout << "gate: " << changes.size() << " thresholds changed in " << path << " (factor "
+            << format_short(factors.value) << ", time factor " << format_short(factors.time_ratio)
+            << ", recovery factor " << format_short(factors.recovery) << ")\n";
+  return 0;
+}
 
+// The check itself: exit 0 when every row passes (and, with --strict, every
+// completed case has a row), 1 otherwise.
+int gate_check(const Args& args, const std::string& dir, const std::string& path, const ThresholdsFile& file) {
   if (args.has("--factor") || args.has("--time-factor") || args.has("--recovery-factor"))
     throw UsageError("--factor/--time-factor/--recovery-factor: only with --update, --init or --add-missing");
   if (file.rows.empty())
@@ -135,6 +120,28 @@ int cmd_gate(const Args& args) {
     }
   }
   return failed ? 1 : 0;
+}
+
+}  // namespace
+
+int cmd_gate(const Args& args) {
+  const std::string dir = args.require("DIR");
+  if (!std::filesystem::is_directory(dir)) throw UsageError(dir + ": no such results folder");
+  GateFactors factors;
+  factors.value = args.number("--factor");
+  factors.time_ratio = args.number("--time-factor");
+  factors.recovery = args.number("--recovery-factor");
+  if (args.has("--init")) return gate_init(args, dir, factors);
+
+  const std::string path = args.has("--thresholds") ? args.get("--thresholds") : kDefaultThresholds;
+  ThresholdsFile file = read_thresholds_file(path);
+  // A folder a matrix is still writing is not re-baselined from.
+  std::unique_ptr<FolderLock> lock;
+  if ((args.has("--add-missing") || args.has("--update")) && std::filesystem::is_directory(dir + "/cases"))
+    lock = std::make_unique<FolderLock>(dir, "cstab gate");
+  if (args.has("--add-missing")) return gate_add_missing(args, dir, factors, path, file);
+  if (args.has("--update")) return gate_update(args, dir, factors, path, file);
+  return gate_check(args, dir, path, file);
 }
 
 }  // namespace cstab::cli

@@ -301,6 +301,37 @@ int unfinished_exit_code(const MatrixRunStats& stats, const std::string& out) {
   return 0;
 }
 
+// Creates the results folder and locks it; a folder created here is removed
+// again when another command holds the lock (nothing left behind).
+std::unique_ptr<FolderLock> open_results_folder(const std::string& out) {
+  std::error_code ec;
+  const bool existed = std::filesystem::exists(out);
+  std::filesystem::create_directories(out, ec);
+  if (ec) throw UsageError("--out " + out + ": cannot create folder: " + ec.message());
+  try {
+    return std::make_unique<FolderLock>(out, "cstab matrix");
+  } catch (const UsageError&) {
+    if (!existed) std::filesystem::remove(out, ec);
+    throw;
+  }
+}
+
+MatrixRunOptions matrix_run_options(const std::string& out, int jobs, bool force, const std::string& matrix_text,
+                                    size_t selected_cases) {
+  MatrixRunOptions opt;
+  opt.out_dir = out;
+  opt.jobs = jobs;
+  opt.force = force;
+  opt.binary_id = binary_identity();
+  if (opt.binary_id == "unknown")
+    std::cout << "matrix: note: the cstab binary cannot be read, so no result is reused or trusted as cached: "
+                 "every case runs\n";
+  opt.matrix_text = matrix_text;
+  opt.selected_cases = selected_cases;
+  opt.find_problem = [](const std::string& name) -> const Problem& { return find_problem(name); };
+  return opt;
+}
+
 }  // namespace
 
 const std::string& default_matrix_text() {
@@ -354,19 +385,9 @@ int cmd_matrix(const Args& args) {
   }
   const std::string out = args.require("--out");
   const int jobs = jobs_flag(args);
-  std::error_code ec;
-  const bool existed = std::filesystem::exists(out);
-  std::filesystem::create_directories(out, ec);
-  if (ec) throw UsageError("--out " + out + ": cannot create folder: " + ec.message());
   // The folder is ours until the end (report included); a second command
   // on it fails now, naming this one.
-  std::unique_ptr<FolderLock> lock;
-  try {
-    lock = std::make_unique<FolderLock>(out, "cstab matrix");
-  } catch (const UsageError&) {
-    if (!existed) std::filesystem::remove(out, ec);  // nothing left behind
-    throw;
-  }
+  const std::unique_ptr<FolderLock> lock = open_results_folder(out);
 
   std::cout << "matrix: " << file.name << ": " << expansion.cases.size() << " cases";
   if (!filter.empty()) std::cout << ", " << filtered.size() << " match --filter '" << filter << "'";
@@ -383,17 +404,7 @@ int cmd_matrix(const Args& args) {
   prov.emplace_back("jobs", std::to_string(jobs));
   write_file_atomic(out + "/provenance.txt", format_provenance(prov));
 
-  MatrixRunOptions opt;
-  opt.out_dir = out;
-  opt.jobs = jobs;
-  opt.force = args.has("--force");
-  opt.binary_id = binary_identity();
-  if (opt.binary_id == "unknown")
-    std::cout << "matrix: note: the cstab binary cannot be read, so no result is reused or trusted as cached: "
-                 "every case runs\n";
-  opt.matrix_text = file.text;
-  opt.selected_cases = filtered.size();
-  opt.find_problem = [](const std::string& name) -> const Problem& { return find_problem(name); };
+  const MatrixRunOptions opt = matrix_run_options(out, jobs, args.has("--force"), file.text, filtered.size());
   const bool tty = ::isatty(STDOUT_FILENO);
   const MatrixRunStats stats = run_matrix(cases, opt, std::cout, tty);
   write_matrix_summary(out, [&] {

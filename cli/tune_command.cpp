@@ -104,6 +104,109 @@ std::string g4(double v) {
   return buf;
 }
 
+// Every setting tried, one row each.
+std::string tune_grid_csv(const TuneConfig& cfg, const TuneResult& res, const std::string& level_name) {
+  const RunConfig& b = cfg.base;
+  std::string grid = "problem,method,integrator,gain_param,gain," + level_name +
+                     ",measure,value,target,reached,status,wall_median,repeats,rhs_evals,cost\n";
+  for (const auto& r : res.runs)
+    grid +=
+        csv_line({b.problem, b.method, b.integrator, res.gain.name, format_exact(r.gain), format_exact(r.level),
+                  cfg.measure, cell(r.value), format_exact(cfg.target), r.reached ? "yes" : "no", r.status,
+                  format_exact(r.wall), std::to_string(r.repeats), std::to_string(r.rhs_evals), format_exact(r.cost)});
+  return grid;
+}
+
+// The closest any run came (least measure value of a run that finished).
+double closest_value(const TuneResult& res) {
+  double closest = NAN;
+  for (const auto& r : res.runs)
+    if (r.status == "ok" && std::isfinite(r.value) && !(r.value >= closest)) closest = r.value;
+  return closest;
+}
+
+// best.csv: the cheapest setting that reaches the target, or `unreachable`.
+std::vector<std::pair<std::string, std::string>> tune_best_row(const TuneConfig& cfg, const TuneResult& res,
+                                                               const std::string& level_name) {
+  const RunConfig& b = cfg.base;
+  const TuneRun& best = res.best;
+  const bool ok = res.reachable;
+  return {
+      {"problem", b.problem},
+      {"method", b.method},
+      {"integrator", b.integrator},
+      {"measure", cfg.measure},
+      {"target", format_exact(cfg.target)},
+      {"result", ok ? "ok" : "unreachable"},
+      {"gain_param", res.gain.name},
+      {"gain", ok ? format_exact(best.gain) : ""},
+      {level_name, ok ? format_exact(best.level) : ""},
+      {"value", ok ? cell(best.value) : ""},
+      {"wall_median", ok ? format_exact(best.wall) : ""},
+      {"rhs_evals", ok ? std::to_string(best.rhs_evals) : ""},
+      {"cost", ok ? format_exact(best.cost) : ""},
+      {"cost_kind", cfg.cost},
+      {"flat_gain_min", ok ? format_exact(res.flat_min) : ""},
+      {"flat_gain_max", ok ? format_exact(res.flat_max) : ""},
+      {"flat_gains", ok ? std::to_string(res.flat_count) : ""},
+      {"closest_value", cell(closest_value(res))},
+      {"runs", std::to_string(res.case_runs)},
+      {"seconds", format_exact(res.seconds)},
+  };
+}
+
+// Cost against gain at the best setting's step or tolerance: one line per gain.
+void print_cost_against_gain(const TuneConfig& cfg, const TuneResult& res, const std::string& level_name) {
+  const TuneRun& best = res.best;
+  std::printf("cost against gain at %s = %s (cheapest: each gain's first %s that reaches)\n", level_name.c_str(),
+              g4(best.level).c_str(), level_name.c_str());
+  std::printf("  %-12s %-10s %-8s %-11s %-10s %-14s %s\n", res.gain.name.c_str(), cfg.measure.c_str(), "reached",
+              "wall (s)", "rhs", ("cheapest " + level_name).c_str(), "cheapest cost / best");
+  for (double g : res.gains) {
+    const TuneRun* at = nullptr;
+    const TuneRun* own = nullptr;
+    for (const auto& r : res.runs)
+      if (r.gain == g) {
+        if (r.level == best.level) at = &r;
+        if (r.reached) own = &r;
+      }
+    std::printf("  %-12s %-10s %-8s %-11s %-10s %-14s %s\n", g4(g).c_str(), at ? g4(at->value).c_str() : "-",
+                at ? (at->reached          ? "yes"
+                      : at->status == "ok" ? "no"
+                                           : at->status.c_str())
+                   : "-",
+                at ? g4(at->wall).c_str() : "-", at ? std::to_string(at->rhs_evals).c_str() : "-",
+                own ? g4(own->level).c_str() : "-", own ? g4(own->cost / best.cost).c_str() : "-");
+  }
+}
+
+// The search's budget, its best setting and how flat the optimum is.
+void print_tune(const TuneConfig& cfg, const TuneResult& res, const std::string& level_name) {
+  const RunConfig& b = cfg.base;
+  const std::string& gname = res.gain.name;
+  const TuneRun& best = res.best;
+  std::printf("%s / %s / %s: tune %s for %s <= %s (cost: %s)\n", b.problem.c_str(), b.method.c_str(),
+              b.integrator.c_str(), gname.c_str(), cfg.measure.c_str(), format_short(cfg.target).c_str(),
+              cfg.cost == "rhs" ? "RHS evaluations" : "median wall seconds");
+  std::printf("budget: %zu gains x %zu %ss (box of %zu settings); %zu settings tried, %ld runs, %.3g s\n",
+              res.gains.size(), res.levels.size(), level_name.c_str(), res.gains.size() * res.levels.size(),
+              res.runs.size(), res.case_runs, res.seconds);
+  if (!res.reachable) {
+    const double closest = closest_value(res);
+    std::printf("unreachable: no setting in the search box reaches %s <= %s (closest: %s)\n", cfg.measure.c_str(),
+                format_short(cfg.target).c_str(), std::isfinite(closest) ? format_3g(closest).c_str() : "none");
+    return;
+  }
+  std::printf("best: %s = %s, %s = %s: %s = %s, wall %.4g s (median of %d), %ld rhs evals\n", gname.c_str(),
+              g4(best.gain).c_str(), level_name.c_str(), g4(best.level).c_str(), cfg.measure.c_str(),
+              format_3g(best.value).c_str(), best.wall, best.repeats, best.rhs_evals);
+  std::printf("flat optimum: %d gain(s) within 20 %% of the best cost, %s in [%s, %s]\n", res.flat_count, gname.c_str(),
+              g4(res.flat_min).c_str(), g4(res.flat_max).c_str());
+  if (res.gains.size() > 1 && (best.gain == res.gains.front() || best.gain == res.gains.back()))
+    std::printf("note: the best gain is at the edge of the search box; a wider --gains may find a cheaper one\n");
+  print_cost_against_gain(cfg, res, level_name);
+}
+
 }  // namespace
 
 int cmd_tune(const Args& args) {
@@ -116,87 +219,13 @@ int cmd_tune(const Args& args) {
 
   const TuneResult res = tune(problem, cfg);
   const std::string level_name = res.fixed_step ? "step" : "tol";
-  const std::string& gname = res.gain.name;
-  const RunConfig& b = cfg.base;
-
-  std::string grid = "problem,method,integrator,gain_param,gain," + level_name +
-                     ",measure,value,target,reached,status,wall_median,repeats,rhs_evals,cost\n";
-  for (const auto& r : res.runs)
-    grid += csv_line({b.problem, b.method, b.integrator, gname, format_exact(r.gain), format_exact(r.level),
-                      cfg.measure, cell(r.value), format_exact(cfg.target), r.reached ? "yes" : "no", r.status,
-                      format_exact(r.wall), std::to_string(r.repeats), std::to_string(r.rhs_evals),
-                      format_exact(r.cost)});
-  // The closest any run came (least measure value of a run that finished).
-  double closest = NAN;
-  for (const auto& r : res.runs)
-    if (r.status == "ok" && std::isfinite(r.value) && !(r.value >= closest)) closest = r.value;
-  const TuneRun& best = res.best;
-  const bool ok = res.reachable;
-  const std::vector<std::pair<std::string, std::string>> best_row = {
-      {"problem", b.problem},
-      {"method", b.method},
-      {"integrator", b.integrator},
-      {"measure", cfg.measure},
-      {"target", format_exact(cfg.target)},
-      {"result", ok ? "ok" : "unreachable"},
-      {"gain_param", gname},
-      {"gain", ok ? format_exact(best.gain) : ""},
-      {level_name, ok ? format_exact(best.level) : ""},
-      {"value", ok ? cell(best.value) : ""},
-      {"wall_median", ok ? format_exact(best.wall) : ""},
-      {"rhs_evals", ok ? std::to_string(best.rhs_evals) : ""},
-      {"cost", ok ? format_exact(best.cost) : ""},
-      {"cost_kind", cfg.cost},
-      {"flat_gain_min", ok ? format_exact(res.flat_min) : ""},
-      {"flat_gain_max", ok ? format_exact(res.flat_max) : ""},
-      {"flat_gains", ok ? std::to_string(res.flat_count) : ""},
-      {"closest_value", cell(closest)},
-      {"runs", std::to_string(res.case_runs)},
-      {"seconds", format_exact(res.seconds)},
-  };
-
   std::error_code ec;
   std::filesystem::create_directories(out, ec);
   if (ec) throw UsageError("--out " + out + ": cannot create folder: " + ec.message());
-  write_file_atomic(out + "/tune.csv", grid);
-  write_file_atomic(out + "/best.csv", key_value_csv(best_row));
-
-  std::printf("%s / %s / %s: tune %s for %s <= %s (cost: %s)\n", b.problem.c_str(), b.method.c_str(),
-              b.integrator.c_str(), gname.c_str(), cfg.measure.c_str(), format_short(cfg.target).c_str(),
-              cfg.cost == "rhs" ? "RHS evaluations" : "median wall seconds");
-  std::printf("budget: %zu gains x %zu %ss (box of %zu settings); %zu settings tried, %ld runs, %.3g s\n",
-              res.gains.size(), res.levels.size(), level_name.c_str(), res.gains.size() * res.levels.size(),
-              res.runs.size(), res.case_runs, res.seconds);
-  if (!ok) {
-    std::printf("unreachable: no setting in the search box reaches %s <= %s (closest: %s)\n", cfg.measure.c_str(),
-                format_short(cfg.target).c_str(), std::isfinite(closest) ? format_3g(closest).c_str() : "none");
-  } else {
-    std::printf("best: %s = %s, %s = %s: %s = %s, wall %.4g s (median of %d), %ld rhs evals\n", gname.c_str(),
-                g4(best.gain).c_str(), level_name.c_str(), g4(best.level).c_str(),
-                cfg.measure.c_str(), format_3g(best.value).c_str(), best.wall, best.repeats, best.rhs_evals);
-    std::printf("flat optimum: %d gain(s) within 20 %% of the best cost, %s in [%s, %s]\n", res.flat_count,
-                gname.c_str(), g4(res.flat_min).c_str(), g4(res.flat_max).c_str());
-    if (res.gains.size() > 1 && (best.gain == res.gains.front() || best.gain == res.gains.back()))
-      std::printf("note: the best gain is at the edge of the search box; a wider --gains may find a cheaper one\n");
-    std::printf("cost against gain at %s = %s (cheapest: each gain's first %s that reaches)\n", level_name.c_str(),
-                g4(best.level).c_str(), level_name.c_str());
-    std::printf("  %-12s %-10s %-8s %-11s %-10s %-14s %s\n", gname.c_str(), cfg.measure.c_str(), "reached",
-                "wall (s)", "rhs", ("cheapest " + level_name).c_str(), "cheapest cost / best");
-    for (double g : res.gains) {
-      const TuneRun* at = nullptr;
-      const TuneRun* own = nullptr;
-      for (const auto& r : res.runs)
-        if (r.gain == g) {
-          if (r.level == best.level) at = &r;
-          if (r.reached) own = &r;
-        }
-      std::printf("  %-12s %-10s %-8s %-11s %-10s %-14s %s\n", g4(g).c_str(), at ? g4(at->value).c_str() : "-",
-                  at ? (at->reached ? "yes" : at->status == "ok" ? "no" : at->status.c_str()) : "-",
-                  at ? g4(at->wall).c_str() : "-", at ? std::to_string(at->rhs_evals).c_str() : "-",
-                  own ? g4(own->level).c_str() : "-", own ? g4(own->cost / best.cost).c_str() : "-");
-    }
-  }
-  if (!args.has("--no-plot") && ok && std::system("command -v gnuplot >/dev/null 2>&1") == 0) {
+  write_file_atomic(out + "/tune.csv", tune_grid_csv(cfg, res, level_name));
+  write_file_atomic(out + "/best.csv", key_value_csv(tune_best_row(cfg, res, level_name)));
+  print_tune(cfg, res, level_name);
+  if (!args.has("--no-plot") && res.reachable && std::system("command -v gnuplot >/dev/null 2>&1") == 0) {
     const std::string cmd = "gnuplot -e \"dir='" + out + "'\" " CSTAB_SOURCE_DIR "/plots/tune.gp";
     if (std::system(cmd.c_str()) != 0) std::cerr << "cstab tune: warning: gnuplot failed\n";
   }

@@ -1463,86 +1463,110 @@ const std::string& CsvTable::get(size_t row, const std::string& name) const {
 
 CsvTable read_csv(const std::string& path) { return parse_csv(read_text_file(path), path); }
 
-CsvTable parse_csv(std::string text, const std::string& path) {
-  if (text.rfind("\xEF\xBB\xBF", 0) == 0) text.erase(0, 3);  // a UTF-8 byte order mark: allowed, skipped
+namespace {
+
+// RFC 4180 records with where each starts: one pass over the text, one
+// character at a time (quoted fields may hold commas, newlines and "").
+class CsvScanner {
+ public:
   std::vector<std::vector<std::string>> records;
-  std::vector<std::string> record;
   std::vector<int> record_lines;                 // the line each record starts on
   std::vector<std::vector<int>> record_columns;  // the column each of its cells starts at
-  std::vector<int> columns;
-  std::string field;
-  bool quoted = false, field_started = false, at_field_start = true;
-  int line = 1, record_line = 1, quote_line = 0, quote_column = 0;
-  size_t line_start = 0;
-  auto end_record = [&] {
-    record.push_back(std::move(field));
-    records.push_back(std::move(record));
-    record_columns.push_back(std::move(columns));
-    record_lines.push_back(record_line);
-    field.clear();
-    record.clear();
-    columns.clear();
-  };
-  for (size_t i = 0; i < text.size(); ++i) {
-    const char c = text[i];
-    const int column = int(i - line_start) + 1;
-    if (at_field_start && !quoted) {
-      if (record.empty()) record_line = line;
-      columns.push_back(column);
-      at_field_start = false;
-    }
-    if (c == '\n') {
-      ++line;
-      line_start = i + 1;
-    }
-    if (quoted) {
-      if (c == '"') {
-        if (i + 1 < text.size() && text[i + 1] == '"') {
-          field += '"';
-          ++i;
-        } else {
-          quoted = false;
-        }
-      } else {
-        field += c;
+
+  void scan(const std::string& text, const std::string& path) {
+    for (size_t i = 0; i < text.size(); ++i) {
+      const char c = text[i];
+      const int column = int(i - line_start_) + 1;
+      if (at_field_start_ && !quoted_) {
+        if (record_.empty()) record_line_ = line_;
+        columns_.push_back(column);
+        at_field_start_ = false;
       }
-      continue;
+      if (c == '\n') {
+        ++line_;
+        line_start_ = i + 1;
+      }
+      if (quoted_)
+        i += quoted_char(c, i + 1 < text.size() ? text[i + 1] : '\0');
+      else
+        plain_char(c, column);
     }
-    if (c == '"' && field.empty()) {
-      quoted = true;
-      quote_line = line;
-      quote_column = column;
-      field_started = true;
+    if (quoted_)
+      throw UsageError(path + ":" + std::to_string(quote_line_) + ":" + std::to_string(quote_column_) +
+                       ": unterminated quoted field");
+    if (field_started_ || !field_.empty() || !record_.empty()) end_record();
+  }
+
+ private:
+  std::vector<std::string> record_;
+  std::vector<int> columns_;
+  std::string field_;
+  bool quoted_ = false, field_started_ = false, at_field_start_ = true;
+  int line_ = 1, record_line_ = 1, quote_line_ = 0, quote_column_ = 0;
+  size_t line_start_ = 0;
+
+  void end_record() {
+    record_.push_back(std::move(field_));
+    records.push_back(std::move(record_));
+    record_columns.push_back(std::move(columns_));
+    record_lines.push_back(record_line_);
+    field_.clear();
+    record_.clear();
+    columns_.clear();
+  }
+  // Inside quotes; returns 1 when it consumed `next` too (a doubled quote).
+  int quoted_char(char c, char next) {
+    if (c != '"') {
+      field_ += c;
+      return 0;
+    }
+    if (next == '"') {
+      field_ += '"';
+      return 1;
+    }
+    quoted_ = false;
+    return 0;
+  }
+  void plain_char(char c, int column) {
+    if (c == '"' && field_.empty()) {
+      quoted_ = true;
+      quote_line_ = line_;
+      quote_column_ = column;
+      field_started_ = true;
     } else if (c == ',') {
-      record.push_back(std::move(field));
-      field.clear();
-      field_started = true;
-      at_field_start = true;
+      record_.push_back(std::move(field_));
+      field_.clear();
+      field_started_ = true;
+      at_field_start_ = true;
     } else if (c == '\n') {
-      if (field_started || !field.empty() || !record.empty())
+      if (field_started_ || !field_.empty() || !record_.empty())
         end_record();
       else
-        columns.clear();  // a blank line
-      field.clear();
-      field_started = false;
-      at_field_start = true;
+        columns_.clear();  // a blank line
+      field_.clear();
+      field_started_ = false;
+      at_field_start_ = true;
     } else if (c != '\r') {
-      field += c;
-      field_started = true;
+      field_ += c;
+      field_started_ = true;
     }
   }
-  if (quoted)
-    throw UsageError(path + ":" + std::to_string(quote_line) + ":" + std::to_string(quote_column) +
-                     ": unterminated quoted field");
-  if (field_started || !field.empty() || !record.empty()) end_record();
+};
+
+}  // namespace
+
+CsvTable parse_csv(std::string text, const std::string& path) {
+  if (text.rfind("\xEF\xBB\xBF", 0) == 0) text.erase(0, 3);  // a UTF-8 byte order mark: allowed, skipped
+  CsvScanner scan;
+  scan.scan(text, path);
   CsvTable t;
   t.path = path;
-  if (records.empty()) return t;
-  t.header = std::move(records.front());
-  t.rows.assign(std::make_move_iterator(records.begin() + 1), std::make_move_iterator(records.end()));
-  t.row_lines.assign(record_lines.begin() + 1, record_lines.end());
-  t.row_columns.assign(std::make_move_iterator(record_columns.begin() + 1),
-                       std::make_move_iterator(record_columns.end()));
+  if (scan.records.empty()) return t;
+  t.header = std::move(scan.records.front());
+  t.rows.assign(std::make_move_iterator(scan.records.begin() + 1), std::make_move_iterator(scan.records.end()));
+  t.row_lines.assign(scan.record_lines.begin() + 1, scan.record_lines.end());
+  t.row_columns.assign(std::make_move_iterator(scan.record_columns.begin() + 1),
+                       std::make_move_iterator(scan.record_columns.end()));
   return t;
 }
 
