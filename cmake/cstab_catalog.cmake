@@ -66,6 +66,18 @@ function(cstab_model model header)
   target_sources(cstab_problems PRIVATE ${dir}/${model}_terms.cpp ${dir}/${model}_start.cpp ${dir}/${model}_jacobian.cpp)
 endfunction()
 
+# Under CSTAB_PCH, TARGET's units include methods/pairs_pch.hpp precompiled
+# (Eigen, the AD scalar, the contracts and the methods' shared headers, which
+# every pair, model and MethodInfo unit includes anyway). A unit compiled
+# with other flags (the uninstrumented pairs of a sanitized build) skips it.
+# A test's own problem class (cstab_test_problem_class) uses the test's
+# precompiled header instead (tests/CMakeLists.txt).
+function(cstab_pch target)
+  if(CSTAB_PCH)
+    target_precompile_headers(${target} PRIVATE ${PROJECT_SOURCE_DIR}/methods/pairs_pch.hpp)
+  endif()
+endfunction()
+
 # Writes FILE only when its content changes, so regenerating the catalog
 # does not recompile pairs that did not change.
 function(_cstab_write file content)
@@ -102,7 +114,10 @@ function(_cstab_pair_source target class file)
     target_sources(${target} PRIVATE ${obj})
   else()
     target_sources(${target} PRIVATE ${file})
-    set_source_files_properties(${file} TARGET_DIRECTORY ${target} PROPERTIES COMPILE_OPTIONS -fno-sanitize=all)
+    # Other flags than the target's precompiled header was built with: the
+    # unit parses the headers itself.
+    set_source_files_properties(${file} TARGET_DIRECTORY ${target} PROPERTIES COMPILE_OPTIONS -fno-sanitize=all
+                                SKIP_PRECOMPILE_HEADERS ON)
   endif()
 endfunction()
 
