@@ -21,12 +21,13 @@
 #   cost   the form and c whose rule costs least on them: the mean over
 #          their cases of log(rule's cost / optimum's cost), a rule that does
 #          not reach a level counting as 100x; c is tried at every gain x h
-#          (or gain) of the tuned grid. (Wider families, gain = c s^p with s
-#          the step or the tolerance and p in {0, +-1/4, ..., +-1}, fit the
-#          other problems better and predict the left-out one worse: on
-#          matrices/gain-rule.toml 94 of 125 cases against 102; docs/measurements.md.) An optimum's gain says little where the cost
-#          is flat in the gain, and one far-off optimum drags the geometric
-#          mean; this fits what the rule is judged by.
+#          (or gain) of the tuned grid. An optimum's gain says little where
+#          the cost is flat in the gain, and one far-off optimum drags the
+#          geometric mean; this fits what the rule is judged by. (Wider
+#          families, gain = c s^p with s the step or the tolerance and p in
+#          {0, +-1/4, ..., +-1}, fit the other problems better and predict
+#          the left-out one worse: on matrices/gain-rule.toml 94 of 125
+#          cases against 102; docs/measurements.md.)
 # GAIN_RULE_FIT=gmean|cost (default cost) picks the fit whose table is printed;
 # the share within 1.5x is printed for both.
 # Cost: RHS evaluations (noise-free), with the wall-time ratio beside it.
@@ -42,6 +43,10 @@ wp=$dir/work_precision.csv
 command -v python3 >/dev/null || { echo "gain-rule: needs python3 (apt-get install python3)" >&2; exit 2; }
 python3 - "$wp" "$levels" <<'PY'
 import csv, math, sys
+
+def die(message):  # bad input: the message, exit 2
+    print(message, file=sys.stderr)
+    sys.exit(2)
 from collections import defaultdict
 
 path, levels_text = sys.argv[1], sys.argv[2]
@@ -49,7 +54,7 @@ try:
     levels = [float(x) for x in levels_text.split()]
     assert levels and all(l > 0 for l in levels)
 except (ValueError, AssertionError):
-    sys.exit("gain-rule: levels '%s': expected numbers > 0" % levels_text)
+    die("gain-rule: levels '%s': expected numbers > 0" % levels_text)
 TIME_SCALE = {"dt"}  # gains that are time scales (ParamRole::kTimeScale)
 
 cases = []  # tuned, finished cases with a reference error
@@ -64,7 +69,7 @@ with open(path, newline="") as f:
                           error=float(r["ref_error"]), rhs=float(r["rhs_evals"] or "nan"),
                           wall=float(r["wall_median_s"] or "nan")))
 if not cases:
-    sys.exit("gain-rule: no finished tuned case with a reference error in %s (run a matrix with the key tune)" % path)
+    die("gain-rule: no finished tuned case with a reference error in %s (run a matrix with the key tune)" % path)
 
 # A rule's form is the power p in gain = c s^p, s the step h (fixed step) or
 # the tolerance (adaptive): "const" is p = 0, "h" is gain x h = c (p = -1; a
@@ -100,7 +105,7 @@ def cheapest(cs, level):
 
 FIT = __import__("os").environ.get("GAIN_RULE_FIT", "cost")
 if FIT not in ("cost", "gmean"):
-    sys.exit("gain-rule: GAIN_RULE_FIT '%s': expected cost or gmean" % FIT)
+    die("gain-rule: GAIN_RULE_FIT '%s': expected cost or gmean" % FIT)
 CAP = 100.0  # a rule that does not reach a level counts as this many times the optimum's cost
 
 def rule_case(cs, p, level, form, c, grid):
