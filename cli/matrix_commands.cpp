@@ -301,21 +301,6 @@ int unfinished_exit_code(const MatrixRunStats& stats, const std::string& out) {
   return 0;
 }
 
-// Creates the results folder and locks it; a folder created here is removed
-// again when another command holds the lock (nothing left behind).
-std::unique_ptr<FolderLock> open_results_folder(const std::string& out) {
-  std::error_code ec;
-  const bool existed = std::filesystem::exists(out);
-  std::filesystem::create_directories(out, ec);
-  if (ec) throw UsageError("--out " + out + ": cannot create folder: " + ec.message());
-  try {
-    return std::make_unique<FolderLock>(out, "cstab matrix");
-  } catch (const UsageError&) {
-    if (!existed) std::filesystem::remove(out, ec);
-    throw;
-  }
-}
-
 MatrixRunOptions matrix_run_options(const std::string& out, int jobs, bool force, const std::string& matrix_text,
                                     size_t selected_cases) {
   MatrixRunOptions opt;
@@ -387,7 +372,8 @@ int cmd_matrix(const Args& args) {
   const int jobs = jobs_flag(args);
   // The folder is ours until the end (report included); a second command
   // on it fails now, naming this one.
-  const std::unique_ptr<FolderLock> lock = open_results_folder(out);
+  const std::unique_ptr<FolderLock> lock =
+      create_locked_folder(out, "cstab matrix", "--out " + out + ": cannot create folder");
 
   std::cout << "matrix: " << file.name << ": " << expansion.cases.size() << " cases";
   if (!filter.empty()) std::cout << ", " << filtered.size() << " match --filter '" << filter << "'";

@@ -10,6 +10,8 @@
 #include <cstdlib>
 #include <cstring>
 #include <exception>
+#include <filesystem>
+#include <memory>
 #include <string>
 
 #include "core/params.hpp"
@@ -91,6 +93,20 @@ FolderLock::~FolderLock() {
   // still held, so a process that opened it meanwhile starts over).
   if (created_ && std::uncaught_exceptions() > uncaught_on_entry_) ::unlink(path_.c_str());
   ::close(fd_);
+}
+
+std::unique_ptr<FolderLock> create_locked_folder(const std::string& dir, const std::string& command,
+                                                 const std::string& what) {
+  std::error_code ec;
+  const bool existed = std::filesystem::exists(dir);
+  std::filesystem::create_directories(dir, ec);
+  if (ec) throw UsageError(what + ": " + ec.message());
+  try {
+    return std::make_unique<FolderLock>(dir, command);
+  } catch (const UsageError&) {
+    if (!existed) std::filesystem::remove(dir, ec);  // nothing left behind
+    throw;
+  }
 }
 
 }  // namespace cstab

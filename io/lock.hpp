@@ -20,6 +20,7 @@
 // without a lock file has no writer.
 #pragma once
 
+#include <memory>
 #include <string>
 
 namespace cstab {
@@ -44,5 +45,12 @@ class FolderLock {
   bool created_ = false;        // this process created the lock file
   int uncaught_on_entry_ = 0;   // std::uncaught_exceptions() when locked
 };
+
+// Creates `dir` (and its parents) and locks it for writing by `command`. A
+// folder this call created is removed again if the lock is refused, so a
+// refused command leaves nothing behind. If the folder cannot be created,
+// throws UsageError("<what>: <reason>").
+std::unique_ptr<FolderLock> create_locked_folder(const std::string& dir, const std::string& command,
+                                                 const std::string& what);
 
 }  // namespace cstab

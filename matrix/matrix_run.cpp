@@ -896,17 +896,8 @@ size_t merge_results(const std::string& out_dir, const std::vector<std::string>&
   if (shards.binaries.size() > 1)
     log << "merge: warning: the shards were run by " << shards.binaries.size() << " different binaries\n";
   // Copy the complete cases, with OUT locked.
+  const std::unique_ptr<FolderLock> lock = create_locked_folder(out_dir, "cstab merge", "cannot create " + out_dir);
   std::error_code ec;
-  const bool existed = fs::exists(out_dir);
-  fs::create_directories(out_dir, ec);
-  if (ec) throw UsageError("cannot create " + out_dir + ": " + ec.message());
-  std::unique_ptr<FolderLock> lock;
-  try {
-    lock = std::make_unique<FolderLock>(out_dir, "cstab merge");
-  } catch (const UsageError&) {
-    if (!existed) fs::remove(out_dir, ec);
-    throw;
-  }
   fs::create_directories(out_dir + "/cases", ec);
   if (ec) throw UsageError("cannot create " + out_dir + ": " + ec.message());
   std::vector<CaseEntry> entries;
