@@ -1,13 +1,13 @@
 #include "harness/stability.hpp"
 
-#include <Eigen/Dense>
-
+#include <Eigen/Core>
 #include <algorithm>
 #include <cmath>
 #include <complex>
 
 #include "core/format.hpp"
 #include "harness/integrator.hpp"
+#include "linalg/dense.hpp"
 
 namespace cstab {
 
@@ -33,7 +33,7 @@ double amplification(const std::string& integrator, double z) {
     companion(0, 2) = k2;
     companion(0, 3) = k3;
     companion(1, 0) = companion(2, 1) = companion(3, 2) = 1;
-    return companion.eigenvalues().cwiseAbs().maxCoeff();
+    return linalg::spectral_radius_of(companion);
   }
   return NAN;
 }

@@ -38,6 +38,13 @@ void ldlt_solve(const double* m, int n, const double* b, double* x) {
   Eigen::Map<Eigen::VectorXd>(x, n) = Map(m, n, n).ldlt().solve(Eigen::Map<const Eigen::VectorXd>(b, n));
 }
 
+double spectral_radius(const double* a, int n) {
+  if (n == 0) return 0;
+  const Eigen::EigenSolver<Eigen::MatrixXd> solver(Map(a, n, n), /*computeEigenvectors=*/false);
+  if (solver.info() != Eigen::Success) return std::numeric_limits<double>::quiet_NaN();
+  return solver.eigenvalues().cwiseAbs().maxCoeff();
+}
+
 }  // namespace cstab::linalg
 
 namespace cstab::linalg {

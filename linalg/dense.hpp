@@ -21,6 +21,10 @@ double lu_rcond(const double* a, int n);
 double lu_solve(const double* a, int n, const double* b, double* x);
 // x = M^-1 b by LDLT of a symmetric n x n matrix (robust Cholesky).
 void ldlt_solve(const double* m, int n, const double* b, double* x);
+// Largest modulus of the eigenvalues of a general (nonsymmetric) n x n
+// matrix, by Eigen's real Schur form; NaN if it does not converge. A
+// fixed-size EigenSolver costs seconds of compile time per size and unit.
+double spectral_radius(const double* a, int n);
 
 template <class Derived>
 int rank_of(const Eigen::MatrixBase<Derived>& a) {
@@ -31,6 +35,11 @@ template <class Derived>
 double condition_number_of(const Eigen::MatrixBase<Derived>& a) {
   const Eigen::Matrix<double, Derived::RowsAtCompileTime, Derived::ColsAtCompileTime> m = a;
   return condition_number(m.data(), int(m.rows()));
+}
+template <class Derived>
+double spectral_radius_of(const Eigen::MatrixBase<Derived>& a) {
+  const Eigen::Matrix<double, Derived::RowsAtCompileTime, Derived::ColsAtCompileTime> m = a;
+  return spectral_radius(m.data(), int(m.rows()));
 }
 template <class Derived>
 double lu_rcond_of(const Eigen::MatrixBase<Derived>& a) {

@@ -150,5 +150,22 @@ TEST(Lu, SolvesSeveralColumnsAsEachAlone) {
   }
 }
 
+// Eigenvalues known in closed form: a scaled rotation (r e^{+-i theta}), an
+// upper-triangular matrix (its diagonal), the companion matrix of
+// (x - 1)(x + 3)(x - 0.5) = x^3 + 1.5 x^2 - 4 x + 1.5 (roots 1, -3, 0.5).
+TEST(SpectralRadius, MatchesClosedForms) {
+  const double r = 2.5, theta = 0.7;
+  Eigen::Matrix2d rotation;
+  rotation << r * std::cos(theta), -r * std::sin(theta), r * std::sin(theta), r * std::cos(theta);
+  EXPECT_NEAR(linalg::spectral_radius_of(rotation), r, 1e-13);
+  Eigen::Matrix3d triangular;
+  triangular << 1, 5, -7, 0, -4, 2, 0, 0, 3;
+  EXPECT_NEAR(linalg::spectral_radius_of(triangular), 4.0, 1e-13);
+  Eigen::Matrix3d companion;
+  companion << -1.5, 4, -1.5, 1, 0, 0, 0, 1, 0;
+  EXPECT_NEAR(linalg::spectral_radius_of(companion), 3.0, 1e-12);
+  EXPECT_EQ(linalg::spectral_radius(nullptr, 0), 0.0);
+}
+
 }  // namespace
 }  // namespace cstab
