@@ -30,6 +30,15 @@
 #          cases against 102; docs/measurements.md.)
 # GAIN_RULE_FIT=gmean|cost (default cost) picks the fit whose table is printed;
 # the share within 1.5x is printed for both.
+# GAIN_RULE_RATES=FILE adds a third form scaled by a property of the
+# problem known before any run: gain = c r, r the problem's characteristic
+# rate (1/s) from FILE, the CSV of bench/problem_rates.cpp
+# (`build/release/bench/cstab-problem-rates > FILE`), column
+# GAIN_RULE_RATE (default rate_median: the spectral radius of the
+# unstabilized index-1 ODE's Jacobian, median along the trajectory).
+# Also printed: the best share any c of the allowed forms reaches when
+# fitted on every problem, the predicted one included, per method and
+# integrator: no leave-one-out fit of the same forms can do better.
 # Cost: RHS evaluations (noise-free), with the wall-time ratio beside it.
 # Prints the cases, c per method and integrator (with RK4's linear theory
 # for a rate gain: stable for gain x h < 2.785, fastest damping at 1.596),
@@ -71,26 +80,50 @@ with open(path, newline="") as f:
 if not cases:
     die("gain-rule: no finished tuned case with a reference error in %s (run a matrix with the key tune)" % path)
 
+import os
+RATES = {}  # problem -> its characteristic rate (GAIN_RULE_RATES)
+if os.environ.get("GAIN_RULE_RATES"):
+    rates_path, column = os.environ["GAIN_RULE_RATES"], os.environ.get("GAIN_RULE_RATE", "rate_median")
+    try:
+        with open(rates_path, newline="") as f:
+            for r in csv.DictReader(f):
+                RATES[r["problem"]] = float(r[column])
+    except (OSError, KeyError, ValueError, TypeError) as e:
+        die("gain-rule: GAIN_RULE_RATES %s: not a cstab-problem-rates CSV with a column %s (%s)" % (
+            rates_path, column, e))
+    missing = sorted({c["problem"] for c in cases} - {p for p, r in RATES.items() if r > 0 and math.isfinite(r)})
+    if missing:
+        die("gain-rule: GAIN_RULE_RATES %s: no rate > 0 for %s" % (rates_path, ", ".join(missing)))
+FORMS_FIXED = ["h", "const"] + (["rate"] if RATES else [])
+FORMS_ADAPTIVE = ["const"] + (["rate"] if RATES else [])
+
 # A rule's form is the power p in gain = c s^p, s the step h (fixed step) or
 # the tolerance (adaptive): "const" is p = 0, "h" is gain x h = c (p = -1; a
-# time scale gain: gain / h = c, p = 1), a number is p itself.
+# time scale gain: gain / h = c, p = 1), a number is p itself; "rate" is
+# gain = c r with r the problem's characteristic rate (a time scale gain:
+# gain = c / r).
 
 def power(form, gain_name):
-    if form == "const":
+    if form in ("const", "rate"):
         return 0
     if form == "h":
         return 1 if gain_name in TIME_SCALE else -1
     return form
 
-def product(c, form):  # what the rule holds constant: gain / s^p
+def rate_factor(form, problem, gain_name):  # r (or 1 / r) in the "rate" form, else 1
+    if form != "rate":
+        return 1.0
+    return 1 / RATES[problem] if gain_name in TIME_SCALE else RATES[problem]
+
+def product(c, form):  # what the rule holds constant: gain / (s^p r)
     if form == "h" and not c["fixed"]:
         return c["gain"]
-    return c["gain"] / c["size"] ** power(form, c["gain_name"])
+    return c["gain"] / c["size"] ** power(form, c["gain_name"]) / rate_factor(form, c["problem"], c["gain_name"])
 
 def fit(optima, fixed):
     """The form whose log c scatters least over `optima`, and c (geometric mean)."""
     best = None
-    for form in (["h", "const"] if fixed else ["const"]):
+    for form in (FORMS_FIXED if fixed else FORMS_ADAPTIVE):
         logs = [math.log(product(o, form)) for o in optima]
         mean = sum(logs) / len(logs)
         spread = math.sqrt(sum((x - mean) ** 2 for x in logs) / len(logs))
@@ -111,14 +144,14 @@ CAP = 100.0  # a rule that does not reach a level counts as this many times the 
 def rule_case(cs, p, level, form, c, grid):
     """The rule's cheapest case on problem p that reaches level (None if none does)."""
     def rule_gain(size):
-        g = c * size ** power(form, cs[0]["gain_name"])
+        g = c * size ** power(form, cs[0]["gain_name"]) * rate_factor(form, p, cs[0]["gain_name"])
         return min(grid, key=lambda x: abs(math.log(x) - math.log(g)))
     return cheapest([x for x in cs if x["problem"] == p and x["gain"] == rule_gain(x["size"])], level)
 
 def fit_by_cost(cs, keys, optimum, fixed, grid):
     """The form (power of h or tol) and c whose rule costs least over the (problem, level) keys."""
     best = None
-    for form in (["h", "const"] if fixed else ["const"]):
+    for form in (FORMS_FIXED if fixed else FORMS_ADAPTIVE):
         for c in sorted({product(x, form) for x in cs}):
             loss = 0.0
             for (p, level) in keys:
@@ -129,6 +162,20 @@ def fit_by_cost(cs, keys, optimum, fixed, grid):
                 best = (form, c, loss)
     return best
 
+def best_in_hindsight(cs, optimum, fixed, grid):
+    """The most (problem, level) keys within 1.5x that one form and c reach, fitted on all of them."""
+    best = (0, None, None)
+    for form in (FORMS_FIXED if fixed else FORMS_ADAPTIVE):
+        for c in sorted({product(x, form) for x in cs}):
+            n = 0
+            for (p, level), opt in optimum.items():
+                ruled = rule_case(cs, p, level, form, c, grid)
+                n += bool(ruled) and ruled["rhs"] / opt["rhs"] <= 1.5
+            if n > best[0]:
+                best = (n, form, c)
+    return best
+
+hindsight = {}  # (method, integrator) -> (cases within 1.5x, form, c), fitted on every problem
 groups = defaultdict(list)
 for c in cases:
     groups[(c["method"], c["integrator"])].append(c)
@@ -150,6 +197,7 @@ for (method, integ), cs in sorted(groups.items()):
     form, c_all, spread = fit(list(optimum.values()), fixed)
     values = [product(o, form) for o in optimum.values()]
     cform, c_cost, loss = fit_by_cost(cs, list(optimum), optimum, fixed, grid)
+    hindsight[(method, integ)] = best_in_hindsight(cs, optimum, fixed, grid)
     fits.append((method, integ, cs[0]["gain_name"], fixed, form, c_all, spread, min(values), max(values), len(values),
                  cform, c_cost, math.exp(loss)))
     fitted = {}  # left-out problem -> {fit: (form, c)}
@@ -172,6 +220,8 @@ for (method, integ), cs in sorted(groups.items()):
             rows.append((p, method, integ, level, best, (form_p, c_rule), ruled, ratio, wall_ratio))
 
 def rule_text(name, form, fixed):
+    if form == "rate":
+        return "%s = c / r" % name if name in TIME_SCALE else "%s = c r" % name
     p = power(form, name)
     if p == 0:
         return "%s = c" % name
@@ -209,4 +259,17 @@ other = "gmean" if FIT == "cost" else "cost"
 print("rule within 1.5x of the tuned optimum (RHS evaluations, leave one problem out), c fitted by %s: %s" % (
     FIT, share(ok)))
 print("  (c fitted by %s instead: %s)" % (other, share(other_ok.get(other, 0))))
+print()
+print("The best any one c of the forms (%s; adaptive: %s) does, fitted on every problem, the predicted one included:" % (
+    ", ".join(FORMS_FIXED), ", ".join(FORMS_ADAPTIVE)))
+print("| method | integrator | rule | c | within 1.5x |")
+print("|---|---|---|---|---|")
+n_best = n_all = 0
+for (method, integ), (n, form, c) in sorted(hindsight.items()):
+    cs = groups[(method, integ)]
+    keys = sum(1 for r in rows if r[1] == method and r[2] == integ)
+    n_best, n_all = n_best + n, n_all + keys
+    print("| %s | %s | %s | %.3g | %d of %d |" % (method, integ, rule_text(cs[0]["gain_name"], form, cs[0]["fixed"]) if form else "-",
+                                             c if c else float("nan"), n, keys))
+print("in hindsight: %d of %d cases (%.0f %%)" % (n_best, n_all, 100.0 * n_best / n_all if n_all else 0))
 PY
