@@ -24,9 +24,8 @@
 #include <random>
 #include <vector>
 
+#include "core/format.hpp"
 #include "harness/integrator.hpp"
-#include "methods/baumgarte.hpp"
-#include "methods/braun_goldfarb.hpp"
 #include "methods/mechanical.hpp"
 #include "problems/biped/biped.hpp"
 #include "problems/registry.hpp"
@@ -308,10 +307,18 @@ struct Trajectory {
   }
 };
 
+// A method on the registered biped (its pair is compiled once, in the
+// library: instantiating the methods here again took this unit to 1 GB).
+std::unique_ptr<Formulation> make_biped(const std::string& method,
+                                        const std::vector<std::pair<std::string, std::string>>& given) {
+  const Problem& p = find_problem("biped");
+  return p.make(method, "mechanical", Params::resolve(p.method_params(method, "mechanical"), given, method));
+}
+
 // rk4 with fixed `step`, correction time scale `dt`, no energy correction.
 Trajectory run_braun_goldfarb(double step, double dt, double t_end) {
-  const Biped biped;
-  BraunGoldfarbFormulation<BM> form(biped.mechanical(), dt, false, 1e-6);
+  const auto formulation = make_biped("braun-goldfarb", {{"dt", format_exact(dt)}, {"energy", "0"}, {"tol", "1e-6"}});
+  Formulation& form = *formulation;
   auto integ = make_integrator("rk4", StepSettings{step, 0, 0});
   std::vector<double> y0(18), r(9);
   form.initial_state(y0.data());
@@ -401,7 +408,8 @@ TEST(BipedRegression, TransientLandsOnTheReferenceContacts) {
 // baumgarte converges to reference() itself.
 TEST(BipedRegression, BaumgarteKeepsTheInitialContacts) {
   const Biped biped;
-  BaumgarteFormulation<BM> form(biped.mechanical(), 10, 10, 10);
+  const auto formulation = make_biped("baumgarte", {{"alpha", "10"}, {"beta", "10"}, {"gamma", "10"}});
+  Formulation& form = *formulation;
   auto integ = make_integrator("rk4", StepSettings{1e-3, 0, 0});
   std::vector<double> y(18), c(18);
   form.initial_state(y.data());
