@@ -15,12 +15,11 @@
 #include <string>
 #include <vector>
 
-#include "harness/integrator.hpp"
 #include "core/params.hpp"
+#include "harness/integrator.hpp"
 #include "harness/run.hpp"
 #include "methods/ida.hpp"
 #include "problems/registry.hpp"
-#include "problems/wheel/wheel.hpp"
 
 namespace cstab {
 namespace {
@@ -267,15 +266,20 @@ TEST(IdaUsage, DaeMethodWithOdeIntegratorAndOdeMethodWithIdaAreUsageErrors) {
 }
 
 TEST(IdaUsage, DaeFormulationRefusesToBeAnOde) {
-  const Wheel wheel;
-  MechanicalDaeFormulation<WheelMechanical, true> ggl(wheel.mechanical(), "ida-ggl");
+  // The registered wheel's ida-ggl pair (compiled once, in the library).
+  const Problem& wheel = find_problem("wheel");
+  const auto formulation =
+      wheel.make("ida-ggl", "mechanical", Params::resolve(wheel.method_params("ida-ggl", "mechanical"), {}, "ida-ggl"));
+  Formulation& ggl = *formulation;
+  const auto* dae = dynamic_cast<const DaeSystem*>(formulation.get());
+  ASSERT_NE(dae, nullptr);
   std::vector<double> y(ggl.dimension()), d(ggl.dimension());
   ggl.initial_state(y.data());
   EXPECT_FALSE(ggl.rhs(0, y.data(), d.data()));
   EXPECT_NE(ggl.failure_reason().find("--integrator ida"), std::string::npos);
   // Layout: [q; v; lambda; mu] with the first 2 nq entries the mechanical state.
   EXPECT_EQ(ggl.dimension(), 2 * 4 + 2 + 1);
-  EXPECT_EQ(ggl.index(), 2);
+  EXPECT_EQ(dae->index(), 2);
   std::vector<double> r(ggl.constraints().size());
   ggl.residuals(0, y.data(), r.data());
   for (double v : r) EXPECT_LT(std::abs(v), 1e-12);
