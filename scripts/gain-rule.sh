@@ -197,7 +197,8 @@ for (method, integ), cs in sorted(groups.items()):
     form, c_all, spread = fit(list(optimum.values()), fixed)
     values = [product(o, form) for o in optimum.values()]
     cform, c_cost, loss = fit_by_cost(cs, list(optimum), optimum, fixed, grid)
-    hindsight[(method, integ)] = best_in_hindsight(cs, optimum, fixed, grid)
+    if len({p for p, _ in optimum}) > 1:  # as the leave-one-out rows: a problem alone has nothing to fit from
+        hindsight[(method, integ)] = best_in_hindsight(cs, optimum, fixed, grid)
     fits.append((method, integ, cs[0]["gain_name"], fixed, form, c_all, spread, min(values), max(values), len(values),
                  cform, c_cost, math.exp(loss)))
     fitted = {}  # left-out problem -> {fit: (form, c)}
