@@ -46,7 +46,7 @@ std::unique_ptr<Formulation> make_on_first(const Problem& p, const std::string& 
 class RateProbe {
  public:
   explicit RateProbe(Formulation& f)
-      : f_(f), n_(f.dimension()), y_(n_), plus_(n_), minus_(n_), fp_(n_), fm_(n_), jacobian_(n_ * n_) {}
+      : f_(f), n_(f.dimension()), plus_(n_), minus_(n_), fp_(n_), fm_(n_), jacobian_(n_ * n_) {}
 
   double at(double t, const std::vector<double>& y) {
     for (int j = 0; j < n_; ++j) {
@@ -62,7 +62,7 @@ class RateProbe {
  private:
   Formulation& f_;
   int n_;
-  std::vector<double> y_, plus_, minus_, fp_, fm_, jacobian_;
+  std::vector<double> plus_, minus_, fp_, fm_, jacobian_;
 };
 
 // Classical RK4 with the formulation's post-step; false if the state stops being finite.
