@@ -3,7 +3,7 @@
 // Jacobian of the unstabilized index-1 ODE (method `none`), by central
 // differences, at the initial state and at 21 states along the trajectory
 // to the reference time (t_end where there is none), followed with
-// `projection` (the index-1 ODE kept on the constraints) on classical RK4
+// `projection` (the index-1 ODE kept on the constraints) on the harness's RK4
 // with a step below 1 / (the rate at t0) and at most T / 20000. The
 // physical modes give eigenvalues +-i omega; the drift modes of the
 // unstabilized ODE are zeros. One CSV row per problem:
@@ -20,6 +20,7 @@
 
 #include "core/formulation.hpp"
 #include "core/params.hpp"
+#include "harness/integrator.hpp"
 #include "linalg/dense.hpp"
 #include "problems/registry.hpp"
 
@@ -27,20 +28,11 @@ namespace {
 
 using namespace cstab;
 
-// The method on the first formulation of `p` it runs on, at its default
-// parameters; nullptr if it runs on none.
-std::unique_ptr<Formulation> make_on_first(const Problem& p, const std::string& method, std::string* formulation) {
+// The method at its default parameters on its default formulation (nullptr
+// if it does not apply to `p`).
+std::unique_ptr<Formulation> make_default(const Problem& p, const std::string& method) {
   if (!p.why_not(method).empty()) return nullptr;
-  for (const auto& f : p.info().formulations) {
-    try {
-      const auto specs = p.method_params(method, f.name);
-      *formulation = f.name;
-      return p.make(method, f.name, Params::resolve(specs, {}, method));
-    } catch (const UsageError&) {
-      // not on this formulation: try the next
-    }
-  }
-  return nullptr;
+  return p.make(method, "", Params::resolve(p.method_params(method, ""), {}, method));
 }
 
 class RateProbe {
@@ -65,29 +57,16 @@ class RateProbe {
   std::vector<double> plus_, minus_, fp_, fm_, jacobian_;
 };
 
-// Classical RK4 with the formulation's post-step; false if the state stops being finite.
-bool rk4_step(Formulation& f, double t, double h, std::vector<double>& y, std::vector<std::vector<double>>& k) {
-  const int n = int(y.size());
-  auto& tmp = k[4];
-  const double c[4] = {0, 0.5, 0.5, 1};
-  for (int s = 0; s < 4; ++s) {
-    for (int i = 0; i < n; ++i) tmp[i] = y[i] + (s == 0 ? 0 : c[s] * h * k[s - 1][i]);
-    if (!f.rhs(t + c[s] * h, tmp.data(), k[s].data())) return false;
-  }
-  for (int i = 0; i < n; ++i) y[i] += h / 6 * (k[0][i] + 2 * k[1][i] + 2 * k[2][i] + k[3][i]);
-  if (f.has_post_step()) f.post_step(t + h, y.data());
-  return std::all_of(y.begin(), y.end(), [](double x) { return std::isfinite(x); });
-}
-
 void print_rates(const Problem& p) {
-  std::string formulation, follow_formulation;
-  auto bare = make_on_first(p, "none", &formulation);
-  auto follow = make_on_first(p, "projection", &follow_formulation);
-  if (!bare || !follow || follow_formulation != formulation || follow->dimension() != bare->dimension()) {
+  auto bare = make_default(p, "none");
+  auto follow = make_default(p, "projection");
+  if (!bare || !follow || follow->formulation_name() != bare->formulation_name() ||
+      follow->dimension() != bare->dimension()) {
     std::fprintf(stderr, "problem-rates: %s: no index-1 ODE (none, projection) on one formulation; left out\n",
                  p.info().name.c_str());
     return;
   }
+  const std::string formulation = bare->formulation_name();
   const int n = bare->dimension();
   std::vector<double> y(n);
   follow->initial_state(y.data());
@@ -98,14 +77,20 @@ void print_rates(const Problem& p) {
   const long steps_per_sample =
       std::max(1000L, long(std::ceil(horizon * std::max(rate0, 0.0) / kSamples)));  // h * rate0 <= 1
   const double h = horizon / double(kSamples * steps_per_sample);
-  std::vector<std::vector<double>> k(5, std::vector<double>(n));
+  auto rk4 = make_integrator("rk4", StepSettings{h, 0, 0});
+  rk4->start(*follow, 0, y.data());
   std::vector<double> rates = {rate0};
-  double t = 0;
-  for (int s = 0; s < kSamples; ++s) {
-    bool finite = true;
-    for (long i = 0; i < steps_per_sample && finite; ++i, t += h) finite = rk4_step(*follow, t, h, y, k);
-    if (!finite) break;
-    rates.push_back(probe.at(t, y));
+  for (int s = 1; s <= kSamples; ++s) {
+    const double t_sample = horizon * s / kSamples;
+    bool ok = true;
+    while (ok && rk4->t() < t_sample - 0.5 * h) {
+      ok = rk4->step(t_sample) == StepOutcome::kOk &&
+           !(follow->has_post_step() && follow->post_step(rk4->t(), rk4->y()) && !rk4->notify_modified()) &&
+           std::all_of(rk4->y(), rk4->y() + n, [](double x) { return std::isfinite(x); });
+    }
+    if (!ok) break;
+    y.assign(rk4->y(), rk4->y() + n);
+    rates.push_back(probe.at(rk4->t(), y));
   }
   std::vector<double> sorted = rates;
   std::sort(sorted.begin(), sorted.end());
