@@ -148,31 +148,35 @@ def rule_case(cs, p, level, form, c, grid):
         return min(grid, key=lambda x: abs(math.log(x) - math.log(g)))
     return cheapest([x for x in cs if x["problem"] == p and x["gain"] == rule_gain(x["size"])], level)
 
+def candidates(cs, fixed):
+    """Every (form, c) a fit tries: each allowed form, c at each case's value of the rule's product."""
+    for form in (FORMS_FIXED if fixed else FORMS_ADAPTIVE):
+        for c in sorted({product(x, form) for x in cs}):
+            yield form, c
+
 def fit_by_cost(cs, keys, optimum, fixed, grid):
     """The form (power of h or tol) and c whose rule costs least over the (problem, level) keys."""
     best = None
-    for form in (FORMS_FIXED if fixed else FORMS_ADAPTIVE):
-        for c in sorted({product(x, form) for x in cs}):
-            loss = 0.0
-            for (p, level) in keys:
-                ruled = rule_case(cs, p, level, form, c, grid)
-                loss += math.log(min(ruled["rhs"] / optimum[(p, level)]["rhs"], CAP) if ruled else CAP)
-            loss /= len(keys)
-            if best is None or loss < best[2] - 1e-12:
-                best = (form, c, loss)
+    for form, c in candidates(cs, fixed):
+        loss = 0.0
+        for (p, level) in keys:
+            ruled = rule_case(cs, p, level, form, c, grid)
+            loss += math.log(min(ruled["rhs"] / optimum[(p, level)]["rhs"], CAP) if ruled else CAP)
+        loss /= len(keys)
+        if best is None or loss < best[2] - 1e-12:
+            best = (form, c, loss)
     return best
 
 def best_in_hindsight(cs, optimum, fixed, grid):
     """The most (problem, level) keys within 1.5x that one form and c reach, fitted on all of them."""
     best = (0, None, None)
-    for form in (FORMS_FIXED if fixed else FORMS_ADAPTIVE):
-        for c in sorted({product(x, form) for x in cs}):
-            n = 0
-            for (p, level), opt in optimum.items():
-                ruled = rule_case(cs, p, level, form, c, grid)
-                n += bool(ruled) and ruled["rhs"] / opt["rhs"] <= 1.5
-            if n > best[0]:
-                best = (n, form, c)
+    for form, c in candidates(cs, fixed):
+        n = 0
+        for (p, level), opt in optimum.items():
+            ruled = rule_case(cs, p, level, form, c, grid)
+            n += bool(ruled) and ruled["rhs"] / opt["rhs"] <= 1.5
+        if n > best[0]:
+            best = (n, form, c)
     return best
 
 hindsight = {}  # (method, integrator) -> (cases within 1.5x, form, c), fitted on every problem
