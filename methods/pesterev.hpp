@@ -14,22 +14,16 @@
 #include "core/formulation.hpp"
 #include "core/params.hpp"
 #include "core/problem.hpp"
+#include "linalg/dense.hpp"
+#include "linalg/small_linalg.hpp"
 #include "methods/affine.hpp"
 #include "methods/contracts.hpp"
 #include "methods/mechanical.hpp"
 #include "methods/mechanical_method.hpp"
-#include "linalg/small_linalg.hpp"
 
 namespace cstab {
 
 namespace pesterev_detail {
-// min |U_ii| / max |U_ii| of a partial-pivoting LU (0 if singular).
-template <class Lu>
-double lu_pivot_ratio(const Lu& lu) {
-  const auto d = lu.matrixLU().diagonal().cwiseAbs();
-  const double mx = d.maxCoeff();
-  return mx > 0 ? d.minCoeff() / mx : 0.0;
-}
 inline double binomial(int n, int k) {
   double r = 1;
   for (int i = 1; i <= k; ++i) r = r * (n - k + i) / i;
@@ -74,16 +68,17 @@ class PesterevFormulation final : public AffineFormulationBase<Model> {
     jet_.evaluate(this->model_, t, X);
     Vec<double, m> phi = jet_.top;
     for (int i = 0; i < m; ++i) phi(i) += jet_.lower.row(i).dot(gains_.row(i));
-    lu_.compute(jet_.A);
+    lu_.compute(jet_.A.data());
     // Singularity check from the LU pivots (min |U_ii| / max |U_ii|): the
     // 1-norm rcond estimate cost a third of this right-hand side (docs/measurements.md, Speed).
-    const double ratio = pesterev_detail::lu_pivot_ratio(lu_);
+    const double ratio = lu_.pivot_ratio();
     if (!(ratio > 1e-14)) {
       this->failure_ = "reaction matrix A(X) singular (LU pivot ratio " + format_3g(ratio) + ") at t = " +
                  std::to_string(t);
       return false;
     }
-    const Vec<double, m> N = lu_.solve(-phi);
+    Vec<double, m> N = -phi;
+    lu_.solve(N.data(), N.data());
     vmap<n>(dydt) = jet_.F + jet_.B * N;
     return true;
   }
@@ -96,7 +91,9 @@ class PesterevFormulation final : public AffineFormulationBase<Model> {
  private:
   Eigen::Matrix<double, m, LieJet<Model>::kMaxDegree> gains_;
   LieJet<Model> jet_;
-  Eigen::PartialPivLU<Eigen::Matrix<double, m, m>> lu_;
+  // Dynamic-size LU, compiled once (linalg/dense.cpp), instead of Eigen's
+  // fixed-size PartialPivLU compiled again in every pair.
+  linalg::Lu lu_{m};
 };
 
 // Lambda-feedback on a mechanical model, written directly in its terms. With

@@ -42,6 +42,7 @@
 
 #include "core/format.hpp"
 #include "linalg/dense.hpp"
+#include "linalg/small_linalg.hpp"
 #include "methods/consistent_start.hpp"
 #include "methods/contracts.hpp"
 #include "methods/mechanical_method.hpp"
@@ -73,7 +74,7 @@ class RattleFormulation final : public SelfSteppingFormulation<Model> {
     model.initial_state(q, v);
     MatQ M;
     model.mass(0.0, q, M);
-    llt_.compute(M);
+    mass_pd_ = mass_.factor(M);
   }
 
   int dimension() const override { return 2 * nq; }
@@ -100,7 +101,7 @@ class RattleFormulation final : public SelfSteppingFormulation<Model> {
     if constexpr (nh > 0) {
       const VecQ q = vmap<nq>(y);
       terms_.evaluate_position(this->model_, t, q);
-      const MatH S = terms_.A * llt_.solve(MatQH(terms_.A.transpose()));
+      const MatH S = terms_.A * minv(MatQH(terms_.A.transpose()));
       return linalg::condition_number(S.data(), nh);
     } else {
       return std::nan("");
@@ -108,12 +109,16 @@ class RattleFormulation final : public SelfSteppingFormulation<Model> {
   }
 
   bool advance(double t, double h, double* y) override {
+    if (!mass_pd_) {
+      this->failure_ = std::string(method_) + ": the mass matrix at t = 0 is not positive definite";
+      return false;
+    }
     const double t1 = t + h, hh = 0.5 * h;
     const VecQ q_n = vmap<nq>(y), v_n = vmap<nq>(y + nq);
     // First half-kick and drift: q1 = qt + (h^2/2) M^-1 G_n^T lambda.
     this->model_.forces(t, q_n, v_n, Q_);
     ++evaluations_;
-    const VecQ vt = v_n + hh * llt_.solve(Q_);
+    const VecQ vt = v_n + hh * mass_.solve(Q_);
     VecQ q1 = q_n + h * vt;
     VecQ v_half = vt;
     int iterations = 0;
@@ -121,7 +126,7 @@ class RattleFormulation final : public SelfSteppingFormulation<Model> {
       // G(q_n) and M^-1 G(q_n)^T: the end of the last step's when it is this state.
       const bool continues = have_last_ && t == last_t_ && q_n == last_q_;
       if (!continues) terms_.evaluate_position(this->model_, t, q_n);
-      const MatQH MinvGt = continues ? MinvG1t_ : MatQH(llt_.solve(MatQH(terms_.A.transpose())));
+      const MatQH MinvGt = continues ? MinvG1t_ : minv(MatQH(terms_.A.transpose()));
       const VecQ qt = q1;
       VecH lambda = VecH::Zero();
       bool converged = false;
@@ -152,7 +157,7 @@ class RattleFormulation final : public SelfSteppingFormulation<Model> {
       }
       v_half = vt + hh * (MinvGt * lambda);
       // G(q1), Phi_t(t1, q1): the last evaluation. The velocity solve's matrix.
-      MinvG1t_ = llt_.solve(MatQH(terms_.A.transpose()));
+      MinvG1t_ = minv(MatQH(terms_.A.transpose()));
       S_ = terms_.A * MinvG1t_;
       velocity_lu_.compute(S_.data());
     } else {
@@ -172,7 +177,7 @@ class RattleFormulation final : public SelfSteppingFormulation<Model> {
     for (int pass = 0; pass <= settings_.max_iterations; ++pass) {
       this->model_.forces(t1, q1, v1, Q_);
       ++evaluations_;
-      VecQ dv = v_half + hh * llt_.solve(Q_);
+      VecQ dv = v_half + hh * mass_.solve(Q_);
       if constexpr (nh > 0) {
         VecH r = -(terms_.A * dv + terms_.phi_t);
         velocity_lu_.solve(r.data(), r.data());
@@ -214,7 +219,7 @@ class RattleFormulation final : public SelfSteppingFormulation<Model> {
   void kick_newton_matrix(double t1, const VecQ& q1, const VecQ& v1, double hh) {
     MechanicalTerms<Model>::force_velocity_jacobian(this->model_, t1, q1, v1, Qv_);
     ++evaluations_;
-    MatQ F = hh * llt_.solve(Qv_);
+    MatQ F = hh * minv(Qv_);
     if constexpr (nh > 0) {
       hq_ = terms_.A * F;
       velocity_lu_.solve_columns(hq_.data(), hq_.data(), nq);
@@ -224,8 +229,22 @@ class RattleFormulation final : public SelfSteppingFormulation<Model> {
     kick_lu_.compute(F.data());
   }
 
+  // M^-1 B, column by column.
+  template <int K>
+  Eigen::Matrix<double, nq, K> minv(Eigen::Matrix<double, nq, K> B) const {
+    for (int c = 0; c < K; ++c) {
+      auto col = B.col(c);
+      mass_.solve_lower_in_place(col);
+      mass_.solve_upper_in_place(col);
+    }
+    return B;
+  }
+
   RattleSettings settings_;
-  Eigen::LLT<MatQ> llt_;  // the constant M
+  // The constant M = L L^T: fixed-size loops (linalg/small_linalg.hpp);
+  // Eigen's fixed-size LLT cost about 2 s of compile time in every pair.
+  SmallCholesky<nq> mass_;
+  bool mass_pd_ = false;
   // Workspaces (no allocation per step).
   MechanicalTerms<Model> terms_;
   VecQ Q_;

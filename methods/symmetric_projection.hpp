@@ -147,8 +147,11 @@ class SymmetricProjectionFormulation final : public SelfSteppingFormulation<Mode
                            format_short(violation) + ")";
           return false;
         }
-        newton_lu_.compute(MatH(c * (J * J.transpose())));
-        const VecH dq = newton_lu_.solve(VecH(-terms_.phi)), dv = newton_lu_.solve(VecH(-rv_));
+        const MatH S = c * (J * J.transpose());
+        newton_lu_.compute(S.data());
+        VecH dq = -terms_.phi, dv = -rv_;
+        newton_lu_.solve(dq.data(), dq.data());
+        newton_lu_.solve(dv.data(), dv.data());
         if (!dq.allFinite() || !dv.allFinite()) {
           this->failure_ = std::string(method_) + ": singular projection matrix J J^T at t = " + format_short(t1);
           return false;
@@ -198,7 +201,9 @@ class SymmetricProjectionFormulation final : public SelfSteppingFormulation<Mode
   VecQ q1_, v1_;
   MatHQ J0_, J1_;
   VecH mu_q_, mu_v_, rv_;
-  Eigen::PartialPivLU<MatH> newton_lu_;
+  // Dynamic-size LU, compiled once (linalg/dense.cpp): Eigen's fixed-size
+  // PartialPivLU cost about 2 s of compile time in every pair.
+  linalg::Lu newton_lu_{nh};
 };
 
 struct SymmetricProjectionMethod : MechanicalMethod<SymmetricProjectionMethod> {
