@@ -52,6 +52,9 @@
 // system at t0, a = vdot; `--param consistent_start=0` starts from
 // a = vdot = 0, lambda = 0 instead (Arnold & Bruls' order-reduction example).
 #pragma once
+// Marks the header for the extern declarations of its shared formulation
+// (cstab_shared_formulation in methods/CMakeLists.txt).
+#define CSTAB_GENERALIZED_ALPHA_HPP
 
 #include <algorithm>
 #include <cmath>

@@ -8,6 +8,9 @@
 //                Phi = 0 (mass-weighted Gauss-Newton), then velocities onto
 //                the velocity constraints (one linear solve).
 #pragma once
+// Marks the header for the extern declarations of its shared formulation
+// (cstab_shared_formulation in methods/CMakeLists.txt).
+#define CSTAB_INDEX1_HPP
 
 #include <cmath>
 
