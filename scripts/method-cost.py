@@ -2,6 +2,11 @@
 """Marginal clean-build cost of each method, from a configured build tree.
 
     python3 scripts/method-cost.py [BUILD_DIR (build/release)] [METHOD ...]
+    python3 scripts/method-cost.py [BUILD_DIR] --units REGEX
+
+The second form measures every unit whose path matches REGEX (e.g.
+'generated/models/' for the models' shared code) the same way, one line
+each and their total.
 
 A method's own units are its generated pair units (one per problem class,
 and one per test problem class such as test_redundant's duplicated
@@ -57,6 +62,26 @@ def scratch_command(entry, scratch):
     return args
 
 
+def units_cost(db, pattern):
+    """CPU of every unit whose path matches PATTERN, one line each, and the total."""
+    try:
+        regex = re.compile(pattern)
+    except re.error as e:
+        print("method-cost: --units: bad regular expression '%s': %s" % (pattern, e), file=sys.stderr)
+        sys.exit(2)
+    units = [e for e in db if regex.search(e["file"])]
+    if not units:
+        print("method-cost: --units: no unit matches '%s'" % pattern, file=sys.stderr)
+        sys.exit(2)
+    total = 0.0
+    with tempfile.TemporaryDirectory() as tmp:
+        for e in units:
+            cpu = cpu_of(scratch_command(e, os.path.join(tmp, "unit.o")), e["directory"])
+            total += cpu
+            print("%6.2f s  %s" % (cpu, os.path.relpath(e["file"], e["directory"])), flush=True)
+    print("%d units  CPU %.1f s" % (len(units), total))
+
+
 def main():
     root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
     argv = sys.argv[1:]
@@ -68,6 +93,11 @@ def main():
         sys.exit("method-cost: %s not found (configure %s first)" % (db_path, build))
     with open(db_path) as f:
         db = json.load(f)
+    if argv[:1] == ["--units"]:
+        if len(argv) != 2:
+            sys.exit("usage: method-cost.py [BUILD_DIR] --units REGEX")
+        units_cost(db, argv[1])
+        return
     methods = method_slugs(root)
     known = {n for n, _ in methods}
     for name in argv:

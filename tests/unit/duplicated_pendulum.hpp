@@ -1,7 +1,8 @@
 // The duplicated pendulum of test_redundant.cpp: a planar pendulum in
 // Cartesian coordinates whose length constraint appears twice. A problem
 // class of the test's own; tests/CMakeLists.txt instantiates every method
-// for it (cstab_test_problem_class), one generated unit per method.
+// for it (cstab_test_problem_class), one generated unit per method, and its
+// model's shared code once (cstab_model).
 #pragma once
 
 #include <Eigen/Dense>
@@ -13,6 +14,7 @@
 #include "core/formulation.hpp"
 #include "core/problem.hpp"
 #include "core/vec.hpp"
+#include "methods/model_templates.hpp"
 
 namespace cstab {
 
@@ -52,6 +54,10 @@ class DuplicatedPendulumModel {
     c[0] = q(0), c[1] = q(1), c[2] = v(0), c[3] = v(1);
   }
 };
+
+// Its shared method code is compiled once, in test_redundant's generated
+// model units (cstab_model in tests/CMakeLists.txt).
+CSTAB_EXTERN_MODEL_TEMPLATES(DuplicatedPendulumModel);
 
 class DuplicatedPendulum {
  public:
