@@ -130,14 +130,64 @@ endfunction()
 
 # Under CSTAB_PCH, TARGET's units include methods/pairs_pch.hpp precompiled
 # (Eigen, the AD scalar, the contracts and the methods' shared headers, which
-# every pair, model and MethodInfo unit includes anyway). A unit compiled
-# with other flags (the uninstrumented pairs of a sanitized build) skips it.
-# A test's own problem class (cstab_test_problem_class) uses the test's
-# precompiled header instead (tests/CMakeLists.txt).
+# every pair, model and MethodInfo unit includes anyway). LIBS are TARGET's
+# links, which give the header the target's flags. A test's own problem
+# class (cstab_test_problem_class) uses the test's precompiled header
+# instead (tests/CMakeLists.txt).
+#
+# The header is precompiled by a target of its own, <TARGET>_pch, with one
+# empty unit, and TARGET's units include it by a target-wide -include. Not
+# by target_precompile_headers on TARGET: CMake's Makefile generator then
+# lists every unit of the target in its flags.make, which the precompiled
+# header and every object depend on, so adding a method or a problem (new
+# pair units) recompiled all of cstab_problems' 300 units (586 s with a
+# copy of baumgarte, scripts/build-cost.sh) instead of the new ones. Each
+# unit depends on the precompiled header through OBJECT_DEPENDS, set when
+# the whole tree is read (_cstab_pch_depends), and the precompiled header
+# on its own flags and headers, so touching one of them still rebuilds
+# every unit. Under CSTAB_SANITIZE the target keeps CMake's own precompiled
+# header: its uninstrumented pairs, compiled with other flags, skip it
+# (SKIP_PRECOMPILE_HEADERS), which a target-wide -include would not.
 function(cstab_pch target)
-  if(CSTAB_PCH)
-    target_precompile_headers(${target} PRIVATE ${PROJECT_SOURCE_DIR}/methods/pairs_pch.hpp)
+  if(NOT CSTAB_PCH)
+    return()
   endif()
+  set(header ${PROJECT_SOURCE_DIR}/methods/pairs_pch.hpp)
+  if(CSTAB_SANITIZE)
+    target_precompile_headers(${target} PRIVATE ${header})
+    return()
+  endif()
+  set(host ${target}_pch)
+  add_library(${host} OBJECT ${PROJECT_SOURCE_DIR}/methods/pairs_pch.cpp)
+  target_link_libraries(${host} PRIVATE ${ARGN})
+  target_precompile_headers(${host} PRIVATE ${header})
+  cstab_include_pch(${target} ${host})
+endfunction()
+
+# TARGET's units include the precompiled header of HOST (a target of
+# target_precompile_headers with the same flags) by a target-wide -include,
+# and depend on it (cstab_pch says why not REUSE_FROM).
+function(cstab_include_pch target host)
+  get_target_property(dir ${host} BINARY_DIR)
+  set(pch ${dir}/CMakeFiles/${host}.dir/cmake_pch.hxx)
+  target_compile_options(${target} PRIVATE -Winvalid-pch -include ${pch})
+  add_dependencies(${target} ${host})
+  # A deferred call's arguments are evaluated when it runs: pass the values.
+  cmake_language(EVAL CODE "cmake_language(DEFER DIRECTORY [[${PROJECT_SOURCE_DIR}]] CALL _cstab_pch_depends [[${target}]] [[${pch}.gch]])")
+endfunction()
+
+# Every unit of TARGET depends on the precompiled header PCH (cstab_pch).
+function(_cstab_pch_depends target pch)
+  get_target_property(sources ${target} SOURCES)
+  get_target_property(dir ${target} SOURCE_DIR)
+  foreach(source ${sources})
+    if(NOT IS_ABSOLUTE ${source})
+      set(source ${dir}/${source})
+    endif()
+    if(source MATCHES "[.]cpp$")
+      set_property(SOURCE ${source} TARGET_DIRECTORY ${target} APPEND PROPERTY OBJECT_DEPENDS ${pch})
+    endif()
+  endforeach()
 endfunction()
 
 # Writes FILE only when its content changes, so regenerating the catalog
