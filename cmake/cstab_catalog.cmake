@@ -51,8 +51,8 @@ endfunction()
 # HEADER, in namespace cstab, with CSTAB_EXTERN_MODEL_TEMPLATES after it:
 # methods/model_templates.hpp), instantiated once in three generated units of
 # cstab_problems (or of TARGET, the optional third argument: a test's own
-# model, declared before its cstab_test_problem_class): MechanicalTerms and NewtonTerms in one, ConsistentStart in
-# the second, AccelerationRowTerms (the index-1 methods' AD Jacobians) in the
+# model, declared before its cstab_test_problem_class): MechanicalTerms and
+# NewtonTerms in one, ConsistentStart in the second, AccelerationRowTerms (the index-1 methods' AD Jacobians) in the
 # third. Apart, the units build in parallel, and GCC's inlining of the
 # Newton Jacobians does not depend on the others' code: in one unit with the start's,
 # car-axis' NewtonTerms lost the inlining of its AD copies and its
@@ -128,10 +128,11 @@ function(_cstab_shared_units target)
   endforeach()
 endfunction()
 
-# Under CSTAB_PCH, TARGET's units include methods/pairs_pch.hpp precompiled
-# (Eigen, the AD scalar, the contracts and the methods' shared headers, which
-# every pair, model and MethodInfo unit includes anyway). LIBS are TARGET's
-# links, which give the header the target's flags. A test's own problem
+# cstab_pch(TARGET LIBS...): under CSTAB_PCH, TARGET's units include
+# methods/pairs_pch.hpp precompiled (Eigen, the AD scalar, the contracts and
+# the methods' shared headers, which every pair, model and MethodInfo unit
+# includes anyway). LIBS are TARGET's links, which give the header the
+# target's flags. A test's own problem
 # class (cstab_test_problem_class) uses the test's precompiled header
 # instead (tests/CMakeLists.txt).
 #
@@ -147,13 +148,15 @@ endfunction()
 # on its own flags and headers, so touching one of them still rebuilds
 # every unit. Under CSTAB_SANITIZE the target keeps CMake's own precompiled
 # header: its uninstrumented pairs, compiled with other flags, skip it
-# (SKIP_PRECOMPILE_HEADERS), which a target-wide -include would not.
+# (SKIP_PRECOMPILE_HEADERS), which a target-wide -include would not. So does
+# a compiler other than GCC (whose precompiled header is not a .gch found
+# by -include).
 function(cstab_pch target)
   if(NOT CSTAB_PCH)
     return()
   endif()
   set(header ${PROJECT_SOURCE_DIR}/methods/pairs_pch.hpp)
-  if(CSTAB_SANITIZE)
+  if(NOT CSTAB_PCH_BY_INCLUDE)
     target_precompile_headers(${target} PRIVATE ${header})
     return()
   endif()
@@ -167,6 +170,12 @@ endfunction()
 # TARGET's units include the precompiled header of HOST (a target of
 # target_precompile_headers with the same flags) by a target-wide -include,
 # and depend on it (cstab_pch says why not REUSE_FROM).
+# Only with GCC, outside the sanitized build (cstab_pch).
+if(CMAKE_CXX_COMPILER_ID STREQUAL "GNU" AND NOT CSTAB_SANITIZE)
+  set(CSTAB_PCH_BY_INCLUDE ON)
+else()
+  set(CSTAB_PCH_BY_INCLUDE OFF)
+endif()
 function(cstab_include_pch target host)
   get_target_property(dir ${host} BINARY_DIR)
   set(pch ${dir}/CMakeFiles/${host}.dir/cmake_pch.hxx)
