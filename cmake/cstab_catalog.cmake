@@ -128,11 +128,11 @@ function(_cstab_shared_units target)
   endforeach()
 endfunction()
 
-# cstab_pch(TARGET LIBS...): under CSTAB_PCH, TARGET's units include
+# cstab_pch(TARGET): under CSTAB_PCH, TARGET's units include
 # methods/pairs_pch.hpp precompiled (Eigen, the AD scalar, the contracts and
 # the methods' shared headers, which every pair, model and MethodInfo unit
-# includes anyway). LIBS are TARGET's links, which give the header the
-# target's flags. A test's own problem
+# includes anyway). Called after TARGET's target_link_libraries: the header
+# is compiled with the same links, hence the same flags. A test's own problem
 # class (cstab_test_problem_class) uses the test's precompiled header
 # instead (tests/CMakeLists.txt).
 #
@@ -162,7 +162,8 @@ function(cstab_pch target)
   endif()
   set(host ${target}_pch)
   add_library(${host} OBJECT ${PROJECT_SOURCE_DIR}/methods/pairs_pch.cpp)
-  target_link_libraries(${host} PRIVATE ${ARGN})
+  get_target_property(links ${target} LINK_LIBRARIES)
+  target_link_libraries(${host} PRIVATE ${links})
   target_precompile_headers(${host} PRIVATE ${header})
   cstab_include_pch(${target} ${host})
 endfunction()
