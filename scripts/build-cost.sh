@@ -7,13 +7,17 @@
 #   4. the rebuild after adding a method (a renamed copy of baumgarte) and
 #      the CPU seconds of the units it adds (its marginal clean-build cost);
 #   5. the same for a problem (a renamed copy of slider-crank).
-#   bash scripts/build-cost.sh [JOBS]      (default: nproc)
+#   bash scripts/build-cost.sh [JOBS] [UNITS_LOG]   (JOBS default: nproc)
+# UNITS_LOG, if given, receives every compile of the run, one line each:
+# "wall_seconds peak_kB source", in build order (the clean build first).
 # Prints one line per figure. ccache is bypassed. Takes 5-10 minutes on 2 cores.
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 jobs=${1:-$(nproc)}
+keep=${2:-}
+[[ -z $keep ]] || keep=$(realpath -m "$keep")
 work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
+trap '[[ -z $keep || ! -f $work/tu.log ]] || cp "$work/tu.log" "$keep"; rm -rf "$work"' EXIT
 git clone -q "$root" "$work/src"
 cd "$work/src"
 export CCACHE_DISABLE=1
