@@ -12,6 +12,12 @@ install(DIRECTORY core linalg io methods problems plugin harness DESTINATION ${C
         FILES_MATCHING PATTERN "*.hpp")
 install(FILES ${CSTAB_GENERATED_DIR}/cstab/build_id.hpp ${CSTAB_GENERATED_DIR}/cstab/every_method.hpp
         DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/cstab/cstab)
+# The built-in models' shared-formulation declarations (cstab_model), which a
+# plugin's pairs include (cmake/cstab_plugin.cmake).
+get_property(cstab_models GLOBAL PROPERTY CSTAB_MODELS)
+list(TRANSFORM cstab_models PREPEND ${CSTAB_GENERATED_DIR}/models/)
+list(TRANSFORM cstab_models APPEND _shared.hpp)
+install(FILES ${cstab_models} DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/cstab/models)
 configure_package_config_file(cmake/cstabConfig.cmake.in ${PROJECT_BINARY_DIR}/cstabConfig.cmake
                               INSTALL_DESTINATION ${cstab_cmake_dir})
 write_basic_package_version_file(${PROJECT_BINARY_DIR}/cstabConfigVersion.cmake COMPATIBILITY ExactVersion)

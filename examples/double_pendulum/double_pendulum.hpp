@@ -12,6 +12,7 @@
 
 #include "core/problem.hpp"
 #include "core/vec.hpp"
+#include "methods/model_templates.hpp"
 #include "problems/common/reference_cache.hpp"
 
 namespace example {
@@ -65,6 +66,17 @@ class DoublePendulumCartesian {
  private:
   DoublePendulumParameters p_;
 };
+
+}  // namespace example
+
+// The code every method shares for this model is compiled once, in the
+// units `cstab_add_problem(... MODELS example::DoublePendulumCartesian)`
+// generates; the pairs declare it extern.
+namespace cstab {
+CSTAB_EXTERN_MODEL_TEMPLATES(::example::DoublePendulumCartesian);
+}  // namespace cstab
+
+namespace example {
 
 // The rod angles (theta1, theta2, theta1', theta2'): the reference's ODE.
 class DoublePendulumAngles {
