@@ -11,15 +11,9 @@
 #pragma once
 
 #include "problems/wheel/wheel.hpp"
+#include "problems/wheel/wheel_parameters.hpp"
 
 namespace cstab {
-
-struct WheelSharpDesign {
-  static constexpr double kSharpness = 0.97;  // r * kappa_max
-  // max over x of kappa(x) = p''(x) / (1 + p'(x)^2)^(3/2) for the wheel's curve.
-  static double max_curvature(const WheelParameters& p, double* at = nullptr);
-  static WheelParameters parameters();
-};
 
 // The "wheel-sharp" problem: a Wheel with the design's parameters, so it
 // reuses every instantiation of the wheel.

@@ -17,7 +17,7 @@
 #include "report/stress_report.hpp"
 #include "methods/pair.hpp"
 #include "problems/registry.hpp"
-#include "problems/wheel/wheel_sharp.hpp"
+#include "problems/wheel/wheel_parameters.hpp"
 #include "tests/support/test_util.hpp"
 
 namespace cstab {

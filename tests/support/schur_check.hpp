@@ -14,6 +14,31 @@
 
 namespace cstab::testing_support {
 
+// The checks of check_schur, on dynamic sizes (compiled once, not once per
+// size): KKT [M -A^T; A 0] [a; N] = [Q; -g] (M a = Q + A^T N, A a + g = 0)
+// solved by a full-pivoting LU; a, N from the solver's three-call path,
+// a2, N2 from its two-substitution path (the methods'), S its Schur
+// complement A M^-1 A^T.
+inline void expect_schur_matches_kkt(const Eigen::MatrixXd& M, const Eigen::MatrixXd& A, const Eigen::VectorXd& Q,
+                                     const Eigen::VectorXd& g, const Eigen::VectorXd& a, const Eigen::VectorXd& N,
+                                     const Eigen::MatrixXd& S, const Eigen::VectorXd& a2, const Eigen::VectorXd& N2) {
+  const Eigen::Index nq = M.rows(), nc = A.rows();
+  Eigen::MatrixXd K = Eigen::MatrixXd::Zero(nq + nc, nq + nc);
+  K.topLeftCorner(nq, nq) = M;
+  K.topRightCorner(nq, nc) = -A.transpose();
+  K.bottomLeftCorner(nc, nq) = A;
+  Eigen::VectorXd rhs(nq + nc);
+  rhs << Q, -g;
+  const Eigen::VectorXd x = K.fullPivLu().solve(rhs);
+  EXPECT_LT((a - x.head(nq)).norm(), 1e-9 * (1 + x.norm()));
+  EXPECT_LT((N - x.tail(nc)).norm(), 1e-9 * (1 + x.norm()));
+  EXPECT_LT((S - A * M.inverse() * A.transpose()).norm(), 1e-10 * S.norm());
+  EXPECT_LT((a2 - x.head(nq)).norm(), 1e-9 * (1 + x.norm()));
+  EXPECT_LT((N2 - x.tail(nc)).norm(), 1e-9 * (1 + x.norm()));
+  EXPECT_LT((M * a2 - Q - A.transpose() * N2).norm(), 1e-9 * (1 + Q.norm()));
+  EXPECT_LT((A * a2 + g).norm(), 1e-9 * (1 + g.norm()));
+}
+
 template <int NQ, int NC>
 void check_schur() {
   std::mt19937 rng(NQ * 100 + NC);
@@ -25,33 +50,15 @@ void check_schur() {
       for (int j = 0; j < NQ; ++j) A(i, j) = u(rng);
     const Eigen::Matrix<double, NQ, 1> Q = Eigen::Matrix<double, NQ, 1>::Random();
     const Eigen::Matrix<double, NC, 1> g = Eigen::Matrix<double, NC, 1>::Random();
-    // KKT: [M -A^T; A 0] [a; N] = [Q; -g]  (M a = Q + A^T N, A a + g = 0)
-    // The reference KKT solve on dynamic sizes (compiled once).
-    Eigen::MatrixXd K = Eigen::MatrixXd::Zero(NQ + NC, NQ + NC);
-    K.topLeftCorner(NQ, NQ) = M;
-    K.topRightCorner(NQ, NC) = -A.transpose();
-    K.bottomLeftCorner(NC, NQ) = A;
-    Eigen::VectorXd rhs(NQ + NC);
-    rhs << Q, -g;
-    const Eigen::VectorXd xd = K.fullPivLu().solve(rhs);
-    const Eigen::Matrix<double, NQ + NC, 1> x = xd;
-
     SCOPED_TRACE(::testing::Message() << "NQ " << NQ << " NC " << NC << " trial " << trial);
     SchurSolver<NQ, NC> s;
     ASSERT_EQ(s.factor(M, A, 1e-14), (SchurSolver<NQ, NC>::Status::kOk));
     const Eigen::Matrix<double, NQ, 1> a_free = s.free_acceleration(Q);
     const Eigen::Matrix<double, NC, 1> N = s.multipliers(-(A * a_free + g));
     const Eigen::Matrix<double, NQ, 1> a = a_free + s.reaction_acceleration(N);
-    EXPECT_LT((a - x.template head<NQ>()).norm(), 1e-9 * (1 + x.norm()));
-    EXPECT_LT((N - x.template tail<NC>()).norm(), 1e-9 * (1 + x.norm()));
-    EXPECT_LT((s.schur() - A * Eigen::MatrixXd(M).inverse() * A.transpose()).norm(), 1e-10 * s.schur().norm());
-    // The two-substitution path the methods use.
     Eigen::Matrix<double, NC, 1> N2;
     const Eigen::Matrix<double, NQ, 1> a2 = s.accelerations(Q, g, &N2);
-    EXPECT_LT((a2 - x.template head<NQ>()).norm(), 1e-9 * (1 + x.norm()));
-    EXPECT_LT((N2 - x.template tail<NC>()).norm(), 1e-9 * (1 + x.norm()));
-    EXPECT_LT((M * a2 - Q - A.transpose() * N2).norm(), 1e-9 * (1 + Q.norm()));
-    EXPECT_LT((A * a2 + g).norm(), 1e-9 * (1 + g.norm()));
+    expect_schur_matches_kkt(M, A, Q, g, a, N, s.schur(), a2, N2);
   }
 }
 
