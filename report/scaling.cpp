@@ -64,7 +64,11 @@ std::vector<Study> collect(const ResultsFolder& folder) {
   std::vector<Study> studies;
   for (const CaseResult& c : folder.cases) {
     if (!c.complete || c.status == Status::kInvalid || c.entry->tuned() || c.entry->integrator == "external") continue;
-    const auto [param, size] = single_param(c.entry->problem_params);
+    // (Named copies, not a structured binding: lambdas capture those only
+    // from clang 16 on.)
+    const auto single = single_param(c.entry->problem_params);
+    const auto& param = single.first;
+    const auto size = single.second;
     if (param.empty()) continue;
     auto s = std::find_if(studies.begin(), studies.end(),
                           [&](const Study& x) { return x.problem == c.entry->problem && x.param == param; });
