@@ -48,10 +48,12 @@ function(cstab_problem name class factory)
 endfunction()
 
 # The code every method shares for the mechanical model MODEL (declared in
-# HEADER, in namespace cstab, with CSTAB_EXTERN_MODEL_TEMPLATES after it:
-# methods/model_templates.hpp), instantiated once in three generated units of
-# cstab_problems (or of TARGET, the optional third argument: a test's own
-# model, declared before its cstab_test_problem_class): MechanicalTerms and
+# HEADER, with CSTAB_EXTERN_MODEL_TEMPLATES after it, inside namespace cstab:
+# methods/model_templates.hpp; a name without "::" is taken in namespace
+# cstab, a qualified one, e.g. a plugin's example::Model, as it is),
+# instantiated once in three generated units of cstab_problems (or of
+# TARGET, the optional third argument: a test's own model, declared before
+# its cstab_test_problem_class, or a plugin's: cstab_add_problem's MODELS): MechanicalTerms and
 # NewtonTerms in one, ConsistentStart in the second, AccelerationRowTerms (the index-1 methods' AD Jacobians) in the
 # third. Apart, the units build in parallel, and GCC's inlining of the
 # Newton Jacobians does not depend on the others' code: in one unit with the start's,

@@ -51,8 +51,8 @@ ${body}}
 ")
 endfunction()
 
-# TARGET's units include methods/pairs_pch.hpp precompiled if it has PAIRS
-# pair units or more than three.
+# TARGET's units include methods/pairs_pch.hpp precompiled if the list PAIRS
+# (its pair units) has more than three.
 function(_cstab_plugin_pch target pairs)
   list(LENGTH pairs n)
   if(n GREATER 3)
