@@ -17,6 +17,9 @@ field() { sed -n "s/.*$1 \([-0-9.e+]*\).*/\1/p" <<<"$2" | head -1; }
 lt() { awk -v a="$1" -v b="$2" 'BEGIN { exit !(a + 0 < b + 0) }'; }
 
 prefix=$work/prefix
+# Plugins are compiled by the compiler that compiled cstab (cstabConfig.cmake checks it).
+cxx=$(sed -n 's/^CMAKE_CXX_COMPILER:[A-Z]*=//p' "$build/CMakeCache.txt")
+[[ -n $cxx ]] || { echo "FAIL: no CMAKE_CXX_COMPILER in $build/CMakeCache.txt"; exit 1; }
 cmake --install "$build" --prefix "$prefix" >/dev/null || { echo "FAIL: cmake --install"; exit 1; }
 C=$prefix/bin/cstab
 [[ -x $C ]] || { echo "FAIL: no installed cstab"; exit 1; }
@@ -24,7 +27,7 @@ C=$prefix/bin/cstab
 # --- the examples, built against the installed package only
 for ex in velocity_projection double_pendulum; do
   start=$(date +%s.%N)
-  if ! { cmake -S "$src/examples/$ex" -B "$work/$ex" -DCMAKE_PREFIX_PATH="$prefix" >"$work/$ex.log" 2>&1 &&
+  if ! { cmake -S "$src/examples/$ex" -B "$work/$ex" -DCMAKE_PREFIX_PATH="$prefix" -DCMAKE_CXX_COMPILER="$cxx" >"$work/$ex.log" 2>&1 &&
          cmake --build "$work/$ex" -j"$(nproc)" >>"$work/$ex.log" 2>&1; }; then
     tail -30 "$work/$ex.log"
     echo "FAIL: building examples/$ex against the installed package"
@@ -35,6 +38,20 @@ done
 VP=$work/velocity_projection/velocity_projection.so
 DP=$work/double_pendulum/double_pendulum.so
 P=(--plugin "$VP" --plugin "$DP")
+
+# --- a plugin configured with another compiler than cstab's: a configure-time error naming the right one
+other=g++
+[[ $cxx == *clang* ]] || other=clang++-14
+if command -v "$other" >/dev/null; then
+  if cmake -S "$src/examples/velocity_projection" -B "$work/other-cxx" -DCMAKE_PREFIX_PATH="$prefix" \
+       -DCMAKE_CXX_COMPILER="$other" >"$work/other-cxx.log" 2>&1; then
+    fail "configuring a plugin with $other (cstab: $cxx) succeeded"
+  elif grep -q -- "-DCMAKE_CXX_COMPILER=$cxx" "$work/other-cxx.log"; then
+    pass "another compiler ($other): configure error naming $cxx"
+  else
+    fail "configuring with $other failed without naming $cxx: $(grep -m1 -A3 'CMake Error' "$work/other-cxx.log")"
+  fi
+fi
 
 # --- cstab list says where each came from
 list=$("$C" list "${P[@]}")
@@ -111,7 +128,7 @@ grep -q "^plugins: .*vp.so (.*method velocity-projection)" "$work/mr/provenance.
 # The method rebuilt with other code (its description changed).
 cp -r "$src/examples/velocity_projection" "$work/vp2-src"
 sed -i 's/(example plugin)/(example plugin, rebuilt)/' "$work/vp2-src/velocity_projection.hpp"
-cmake -S "$work/vp2-src" -B "$work/vp2" -DCMAKE_PREFIX_PATH="$prefix" >/dev/null 2>&1 &&
+cmake -S "$work/vp2-src" -B "$work/vp2" -DCMAKE_PREFIX_PATH="$prefix" -DCMAKE_CXX_COMPILER="$cxx" >/dev/null 2>&1 &&
   cmake --build "$work/vp2" -j"$(nproc)" >/dev/null 2>&1 || fail "rebuilding velocity_projection"
 cp "$work/vp2/velocity_projection.so" "$work/vp.so"
 s3=$(summary "$("$C" matrix "$work/m.toml" --out "$work/mr" --jobs 2 --no-report 2>&1)")
@@ -127,7 +144,7 @@ for so in "$VP" "$DP"; do
     { cat "$work/check.out"; fail "check $(basename "$so"): exit $rc"; }
 done
 for b in bad_jacobian bad_methods; do
-  cmake -S "$src/tests/plugins/$b" -B "$work/$b" -DCMAKE_PREFIX_PATH="$prefix" >"$work/$b.log" 2>&1 &&
+  cmake -S "$src/tests/plugins/$b" -B "$work/$b" -DCMAKE_PREFIX_PATH="$prefix" -DCMAKE_CXX_COMPILER="$cxx" >"$work/$b.log" 2>&1 &&
     cmake --build "$work/$b" -j"$(nproc)" >>"$work/$b.log" 2>&1 || { tail -20 "$work/$b.log"; fail "building $b"; }
 done
 expect_check() {  # expect_check SO ROW_REGEX WHAT: exit 1 and a FAIL row matching ROW_REGEX
@@ -157,7 +174,7 @@ expect_check "$work/bad_methods/ignores_constraints.so" \
 inc=(-I"$prefix/include/cstab" -I/usr/include/eigen3)
 bad_so() {  # bad_so NAME SOURCE: a shared object from SOURCE
   printf '%s\n' "$2" >"$work/$1.cpp"
-  c++ -std=c++20 -shared -fPIC "${inc[@]}" "$work/$1.cpp" -o "$work/$1.so" || fail "compiling $1"
+  "$cxx" -std=c++20 -shared -fPIC "${inc[@]}" "$work/$1.cpp" -o "$work/$1.so" || fail "compiling $1"
 }
 entry='#include "plugin/api.hpp"
 extern "C" const char* cstab_plugin_build_id(void) { return CSTAB_PLUGIN_BUILD; }'

@@ -25,9 +25,12 @@
 #include "harness/run.hpp"
 #include "methods/pair.hpp"
 #include "problems/registry.hpp"
+#include "tests/support/escape.hpp"
 
 namespace cstab {
 namespace {
+
+using testing::escape;
 
 TEST(AllocationCounter, CountsAllocations) {
   // The counter itself must see an allocation, or every zero below is vacuous.
@@ -35,6 +38,8 @@ TEST(AllocationCounter, CountsAllocations) {
   {
     AllocationWindow w;
     auto* v = new std::vector<double>(100);
+    escape(v);
+    escape(v->data());
     seen = w.count();
     delete v;
   }
@@ -85,6 +90,7 @@ TEST(AllocationCounter, TellsLibraryAllocationsApart) {
     gsl_vector* g = gsl_vector_alloc(16);
     Eigen::VectorXd v(16);
     v.setZero();
+    escape(v.data());
     gsl_vector_set_zero(g);
     own = w.count();
     library = w.library_count();

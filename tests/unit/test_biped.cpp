@@ -94,7 +94,9 @@ TEST(BipedModel, ParametersAndInconsistency) {
 TEST(BipedModel, ConstraintsMatchThePointKinematics) {
   const Biped biped;
   const BM& m = biped.mechanical();
-  for (const auto& [q, v] : sample_states()) {
+  for (const auto& state : sample_states()) {
+    const V9& q = state.first;  // named, not bound: clang 14 lambdas cannot capture bindings
+    const V9& v = state.second;
     Vec<double, 7> phi;
     m.holonomic(0.37, q, phi);
     EXPECT_NEAR(phi(0), m.point(q, m.heel(0))(1), 1e-14);
@@ -112,7 +114,9 @@ TEST(BipedModel, ConstraintsMatchThePointKinematics) {
 TEST(BipedModel, MassMatrixIsTheKineticEnergy) {
   const Biped biped;
   const BM& m = biped.mechanical();
-  for (const auto& [q, v] : sample_states()) {
+  for (const auto& state : sample_states()) {
+    const V9& q = state.first;  // named, not bound: clang 14 lambdas cannot capture bindings
+    const V9& v = state.second;
     M9 M;
     m.mass(0.0, q, M);
     EXPECT_LT((M - M.transpose()).norm(), 1e-12);
@@ -133,7 +137,9 @@ TEST(BipedModel, ForcesAreLagrangesEquations) {
   const Biped biped;
   const BM& m = biped.mechanical();
   using D = ad::Dual<9>;
-  for (const auto& [q, v] : sample_states()) {
+  for (const auto& state : sample_states()) {
+    const V9& q = state.first;  // named, not bound: clang 14 lambdas cannot capture bindings
+    const V9& v = state.second;
     Vec<D, 9> qd;
     for (int i = 0; i < 9; ++i) qd(i) = D(q(i), 9, i);
     Eigen::Matrix<D, 9, 9> Md;
@@ -163,7 +169,9 @@ TEST(BipedModel, ForcesAreLagrangesEquations) {
 TEST(BipedModel, ConstraintDerivativesMatchFiniteDifferences) {
   const Biped biped;
   const BM& m = biped.mechanical();
-  for (const auto& [q, v] : sample_states()) {
+  for (const auto& state : sample_states()) {
+    const V9& q = state.first;  // named, not bound: clang 14 lambdas cannot capture bindings
+    const V9& v = state.second;
     for (double t : {0.0, 0.23, 1.4}) {
       MechanicalTerms<BM> terms;
       terms.evaluate(m, t, q, v, false);

@@ -706,11 +706,11 @@ TEST(MatrixTune, ReportDrawsTheEnvelopeAndComparesItWithTheDefaults) {
       tuned.emplace_back(std::stod(wp.get(r, "wall_median_s")), std::stod(wp.get(r, "ref_error")));
   ASSERT_EQ(tuned.size() > 5, true) << "5 gains x 3 steps, some diverge";
   std::set<double> non_dominated;
-  for (const auto& [w, e] : tuned)
+  for (const auto& p : tuned)
     if (std::none_of(tuned.begin(), tuned.end(), [&](const std::pair<double, double>& d) {
-          return (d.first < w && d.second <= e) || (d.first <= w && d.second < e);
+          return (d.first < p.first && d.second <= p.second) || (d.first <= p.first && d.second < p.second);
         }))
-      non_dominated.insert(w);
+      non_dominated.insert(p.first);
   // The picture's block of that curve.
   const Outcome dat = sh("zcat " + dir + "/out/plots/data/wheel_work_precision.dat.gz");
   ASSERT_EQ(dat.code, 0) << dat.out;

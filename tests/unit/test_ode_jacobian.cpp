@@ -121,9 +121,10 @@ TEST_P(OdeJacobian, MatchesDifferenceQuotients) {
     for (int j = 0; j < n; ++j)
       ASSERT_TRUE(difference_column(*form, t, y, j, 1e-4 * (1 + std::abs(y[j])), fd[j])) << form->failure_reason();
     // Within 1e-5 relative to the entry, with floors for entries that
-    // vanish: 1e-3 of the row's largest and of the whole matrix's (at
-    // least 1, its identity block), i.e. an absolute 1e-8 of the matrix:
-    // the differences' round-off is 1.3e-8 where AD gives 1e-14 on the biped.
+    // vanish: 2e-3 of the row's largest and of the whole matrix's (at
+    // least 1, its identity block), i.e. an absolute 2e-8 of the matrix:
+    // the differences' round-off on the biped is 1.3e-8 built by GCC 12 and
+    // 2.1e-8 by clang 14 (entry (17, 8), where AD gives 6e-15).
     double scale = 0;
     for (int j = 0; j < n; ++j)
       for (int i = 0; i < n; ++i) scale = std::max(scale, std::abs(fd[j][i]));
@@ -132,7 +133,7 @@ TEST_P(OdeJacobian, MatchesDifferenceQuotients) {
       for (int j = 0; j < n; ++j) row_scale = std::max(row_scale, std::abs(fd[j][i]));
       for (int j = 0; j < n; ++j) {
         const double err =
-            std::abs(J[i + size_t(j) * n] - fd[j][i]) / (std::abs(fd[j][i]) + 1e-3 * row_scale + 1e-3 * scale);
+            std::abs(J[i + size_t(j) * n] - fd[j][i]) / (std::abs(fd[j][i]) + 2e-3 * row_scale + 2e-3 * scale);
         if (err > worst) worst = err, worst_i = i, worst_j = j;
       }
     }
