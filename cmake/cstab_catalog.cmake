@@ -189,8 +189,9 @@ endfunction()
 # every unit. Under CSTAB_SANITIZE the target keeps CMake's own precompiled
 # header: its uninstrumented pairs, compiled with other flags, skip it
 # (SKIP_PRECOMPILE_HEADERS), which a target-wide -include would not. So does
-# a compiler other than GCC (whose precompiled header is not a .gch found
-# by -include).
+# a compiler other than GCC and clang: both find the precompiled header that
+# CMake makes beside cmake_pch.hxx (GCC's .gch, clang's .pch) when a unit
+# says -include cmake_pch.hxx.
 function(cstab_pch target)
   if(NOT CSTAB_PCH)
     return()
@@ -211,9 +212,13 @@ endfunction()
 # TARGET's units include the precompiled header of HOST (a target of
 # target_precompile_headers with the same flags) by a target-wide -include,
 # and depend on it (cstab_pch says why not REUSE_FROM).
-# Only with GCC, outside the sanitized build (cstab_pch).
+# Only with GCC or clang, outside the sanitized build (cstab_pch).
 if(CMAKE_CXX_COMPILER_ID STREQUAL "GNU" AND NOT CSTAB_SANITIZE)
   set(CSTAB_PCH_BY_INCLUDE ON)
+  set(CSTAB_PCH_SUFFIX .gch)
+elseif(CMAKE_CXX_COMPILER_ID STREQUAL "Clang" AND NOT CSTAB_SANITIZE)
+  set(CSTAB_PCH_BY_INCLUDE ON)
+  set(CSTAB_PCH_SUFFIX .pch)
 else()
   set(CSTAB_PCH_BY_INCLUDE OFF)
 endif()
@@ -223,7 +228,7 @@ function(cstab_include_pch target host)
   target_compile_options(${target} PRIVATE -Winvalid-pch -include ${pch})
   add_dependencies(${target} ${host})
   # A deferred call's arguments are evaluated when it runs: pass the values.
-  cmake_language(EVAL CODE "cmake_language(DEFER DIRECTORY [[${PROJECT_SOURCE_DIR}]] CALL _cstab_pch_depends [[${target}]] [[${pch}.gch]])")
+  cmake_language(EVAL CODE "cmake_language(DEFER DIRECTORY [[${PROJECT_SOURCE_DIR}]] CALL _cstab_pch_depends [[${target}]] [[${pch}${CSTAB_PCH_SUFFIX}]])")
 endfunction()
 
 # Every unit of TARGET depends on the precompiled header PCH (cstab_pch).
