@@ -246,8 +246,10 @@ int run_in_worker(const MatrixCase& c, const Problem& problem, const std::string
   return code;
 }
 
+// h:mm:ss or m:ss; "?" when unknown or past 100 hours (an ETA from a first
+// case that cost next to nothing: converting it to long would overflow).
 std::string clock_text(double seconds) {
-  if (!std::isfinite(seconds) || seconds < 0) return "?";
+  if (!std::isfinite(seconds) || seconds < 0 || seconds >= 360000) return "?";
   const long s = long(seconds + 0.5);
   char buf[32];
   if (s >= 3600)
