@@ -1,12 +1,14 @@
 #!/usr/bin/env bash
 # Installs the Debian 12 packages cstab needs (plus any given as arguments), only those missing.
 # clang-14 compiles cstab (the presets choose it: 0.65 of GCC 12's compile time, docs/build.md);
-# libclang-rt-14-dev holds its sanitizer runtimes (the sanitize preset); g++ stays for libstdc++
+# libclang-rt-14-dev holds its sanitizer runtimes (the sanitize preset), libomp-14-dev the OpenMP
+# that SUNDIALS' CMake package asks the compiler for (find_dependency(OpenMP): with clang it is
+# LLVM's libomp, with GCC libgomp, which g++ brings); g++ stays for libstdc++
 # and the release-gcc preset.
 set -euo pipefail
 packages=(g++ cmake make libeigen3-dev libsundials-dev libgsl-dev libbenchmark-dev libfccp-dev libtomlplusplus-dev
           gnuplot-nox googletest libgtest-dev libcli11-dev zlib1g-dev parallel lld
-          libsimbody-dev libmujoco-dev clang-14 libclang-rt-14-dev "$@")
+          libsimbody-dev libmujoco-dev clang-14 libclang-rt-14-dev libomp-14-dev "$@")
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
