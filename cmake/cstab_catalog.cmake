@@ -189,7 +189,7 @@ endfunction()
 # every unit. Under CSTAB_SANITIZE the target keeps CMake's own precompiled
 # header: its uninstrumented pairs, compiled with other flags, skip it
 # (SKIP_PRECOMPILE_HEADERS), which a target-wide -include would not. So does
-# a compiler other than GCC and clang: both find the precompiled header that
+# a compiler other than GCC or clang; those two find the precompiled header that
 # CMake makes beside cmake_pch.hxx (GCC's .gch, clang's .pch) when a unit
 # says -include cmake_pch.hxx.
 function(cstab_pch target)
@@ -213,14 +213,13 @@ endfunction()
 # target_precompile_headers with the same flags) by a target-wide -include,
 # and depend on it (cstab_pch says why not REUSE_FROM).
 # Only with GCC or clang, outside the sanitized build (cstab_pch).
-if(CMAKE_CXX_COMPILER_ID STREQUAL "GNU" AND NOT CSTAB_SANITIZE)
+set(CSTAB_PCH_BY_INCLUDE OFF)
+if(CMAKE_CXX_COMPILER_ID MATCHES "^(GNU|Clang)$" AND NOT CSTAB_SANITIZE)
   set(CSTAB_PCH_BY_INCLUDE ON)
+endif()
+set(CSTAB_PCH_SUFFIX .pch)
+if(CMAKE_CXX_COMPILER_ID STREQUAL "GNU")
   set(CSTAB_PCH_SUFFIX .gch)
-elseif(CMAKE_CXX_COMPILER_ID STREQUAL "Clang" AND NOT CSTAB_SANITIZE)
-  set(CSTAB_PCH_BY_INCLUDE ON)
-  set(CSTAB_PCH_SUFFIX .pch)
-else()
-  set(CSTAB_PCH_BY_INCLUDE OFF)
 endif()
 function(cstab_include_pch target host)
   get_target_property(dir ${host} BINARY_DIR)
