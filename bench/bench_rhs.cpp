@@ -123,7 +123,10 @@ int main(int argc, char** argv) {
   const auto& med = reporter.medians();
   std::printf("\n%-12s %-28s %10s %9s %9s %12s %10s\n", "problem", "formulation", "rhs_ns", "rhs/bare", "rhs/min",
               "rk4_step_ns", "step/bare");
-  for (const auto& [pname, label] : rows) {
+  for (const auto& row : rows) {
+    // Named, not a structured binding: clang before 16 does not let a lambda capture one.
+    const std::string& pname = row.first;
+    const std::string& label = row.second;
     auto get = [&](const std::string& kind, const std::string& l) {
       auto it = med.find(kind + "/" + pname + "/" + l);
       return it == med.end() ? -1.0 : it->second;
