@@ -21,7 +21,6 @@ import concurrent.futures
 import json
 import os
 import re
-import resource
 import shlex
 import subprocess
 import sys
@@ -49,15 +48,12 @@ def kind(path):
 
 
 def cpu_of(argv, cwd):
-    """CPU seconds of the child that runs argv (None if it fails)."""
-    with tempfile.NamedTemporaryFile() as t:
-        # /usr/bin/time measures just this child, whatever runs beside it.
-        done = subprocess.run(["/usr/bin/time", "-o", t.name, "-f", "%U %S"] + argv, cwd=cwd,
-                              stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-        if done.returncode != 0:
-            return None
-        user, system = open(t.name).read().split()[-2:]
-        return float(user) + float(system)
+    """CPU seconds (user + system) of the child that runs argv; None if it fails."""
+    # wait4 reports this child's own usage, whatever else runs beside it.
+    child = subprocess.Popen(argv, cwd=cwd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    _, status, usage = os.wait4(child.pid, 0)
+    child.returncode = os.waitstatus_to_exitcode(status)
+    return usage.ru_utime + usage.ru_stime if child.returncode == 0 else None
 
 
 def measure(numbered, scratch):
